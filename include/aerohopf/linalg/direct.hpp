@@ -41,7 +41,7 @@ class direct_solver<Matrix, std::enable_if_t<!is_sparse_matrix_v<Matrix>>> {
     if (!a.allFinite()) throw singular_matrix_error(context_ + ": matrix has non-finite entries");
     lu_.compute(a);
     const double rc = static_cast<double>(std::abs(lu_.rcond()));
-    if (!(rc > 1e3 * Eigen::NumTraits<double>::epsilon()) && a.rows() > 0)
+    if (!(rc > Eigen::NumTraits<double>::epsilon()) && a.rows() > 0)
       throw singular_matrix_error(internal::concat(context_, ": matrix is singular to working precision (rcond ",
                                                    rc, ")"));
     return *this;

@@ -1,0 +1,126 @@
+#pragma once
+// Shift-invert inverse power iteration with a complex shift (spec 02):
+//
+//     (A - sigma I) y^t = x^{t-1},    x^t = y^t / ||y^t||
+//
+// converges to the eigenvector whose eigenvalue is nearest sigma, at the rate
+// |lambda_1 - sigma| / |lambda_2 - sigma|. It is used (a) to start the Hopf Newton iteration from
+// a structural frequency, (b) to trace an aeroelastic eigenvalue along mu (root locus, the
+// previous eigenvalue as the next shift) and (c) for the adjoint eigenvector q of the
+// centre-manifold reduction. The shifted matrix is factored once and reused every iteration.
+// The complex form A - sigma I is preferred over the real 2n form: it keeps the sparsity of A.
+//
+// Eigenvalue estimate: with C = A - sigma I and C y = x, the Rayleigh quotient of C on y is
+// <y, C y>/<y, y> = <y, x>/<y, y>, so lambda = sigma + <y, x>/<y, y>.
+// Convergence: ||A x - lambda x||_2 <= tolerance * max(1, |lambda|) with ||x||_2 = 1.
+#include <Eigen/Core>
+
+#include <cmath>
+#include <complex>
+#include <iostream>
+
+#include "../error.hpp"
+#include "../linalg/direct.hpp"
+
+namespace aerohopf {
+
+struct inverse_power_options {
+  double tolerance = 1e-12;  ///< on ||A x - lambda x||_2 / max(1, |lambda|), ||x||_2 = 1
+  int max_iterations = 100;
+  bool verbose = false;
+  std::ostream* log = &std::cout;
+};
+
+struct eigen_pair {
+  std::complex<double> lambda;
+  vec<std::complex<double>> vector;  ///< unit 2-norm, largest component real and positive
+  int iterations = 0;
+  double residual = 0;  ///< ||A x - lambda x||_2
+};
+
+namespace internal {
+
+/// Fix the free phase: largest-magnitude component real and positive.
+inline void normalise_phase(vec<std::complex<double>>& x) {
+  Eigen::Index imax = 0;
+  x.cwiseAbs().maxCoeff(&imax);
+  const std::complex<double> a = x[imax];
+  x *= std::abs(a) / a;
+  x.normalize();
+}
+
+/// A deterministic start vector with components in every direction (no accidental
+/// orthogonality to the wanted eigenvector in practice).
+inline vec<std::complex<double>> default_start(Eigen::Index n) {
+  vec<std::complex<double>> x(n);
+  for (Eigen::Index i = 0; i < n; ++i)
+    x[i] = {1.0 + 0.37 * std::sin(1.3 * double(i) + 0.2), 0.5 * std::cos(0.7 * double(i) + 0.1)};
+  return x.normalized();
+}
+
+template <class Matrix>
+eigen_pair inverse_power_impl(const Matrix& a, std::complex<double> shift, const inverse_power_options& opt,
+                              const vec<std::complex<double>>* start, const char* who) {
+  using C = std::complex<double>;
+  require(a.rows() == a.cols(), who, ": matrix is ", a.rows(), "x", a.cols(), ", not square");
+  require(!start || start->size() == a.rows(), who, ": start vector has ", start ? start->size() : 0,
+          " entries, matrix ", a.rows());
+  // A shift that is an eigenvalue to working precision (e.g. the exact i omega at a Hopf point)
+  // makes A - sigma I singular; inverse power only needs it invertible, so nudge the shift.
+  using shifted_type = decltype(shifted(a, shift));
+  direct_solver<shifted_type> solver(std::string(who) + " (A - sigma I)");
+  for (int attempt = 0;; ++attempt) {
+    try {
+      solver.compute(shifted(a, shift));
+      break;
+    } catch (const singular_matrix_error&) {
+      if (attempt == 3) throw;
+      shift += std::complex<double>(1e-9, 1e-9) * std::max(1.0, std::abs(shift)) * std::pow(10.0, attempt);
+    }
+  }
+  const auto ac = a.template cast<C>();
+
+  vec<C> x = start ? start->normalized() : default_start(a.rows());
+  if (!x.allFinite() || x.norm() == 0) x = default_start(a.rows());
+  eigen_pair r;
+  for (int t = 1; t <= opt.max_iterations; ++t) {
+    const vec<C> y = solver.solve(x);
+    const double ny2 = y.squaredNorm();
+    if (!(ny2 > 0) || !std::isfinite(ny2))
+      throw convergence_error(internal::concat(who, ": iterate ", t, " is zero or not finite"));
+    r.lambda = shift + y.dot(x) / ny2;
+    x = y / std::sqrt(ny2);
+    r.residual = (ac * x - r.lambda * x).norm();
+    r.iterations = t;
+    if (opt.verbose && opt.log)
+      *opt.log << who << " it " << t << "  lambda " << r.lambda << "  residual " << r.residual << "\n";
+    if (r.residual <= opt.tolerance * std::max(1.0, std::abs(r.lambda))) {
+      normalise_phase(x);
+      r.vector = x;
+      return r;
+    }
+  }
+  throw convergence_error(internal::concat(who, ": no convergence in ", opt.max_iterations,
+                                           " iterations (shift ", shift, ", last lambda ", r.lambda,
+                                           ", residual ", r.residual, ")"));
+}
+
+}  // namespace internal
+
+/// Eigenpair of A whose eigenvalue is nearest shift.
+template <class Matrix>
+eigen_pair inverse_power(const Matrix& a, std::complex<double> shift, const inverse_power_options& opt = {},
+                         const vec<std::complex<double>>* start = nullptr) {
+  return internal::inverse_power_impl(a, shift, opt, start, "inverse power");
+}
+
+/// Adjoint eigenpair: eigenvector q of A^T for the eigenvalue nearest conj(shift). For the
+/// right pair A p = i omega p (shift i omega) this gives A^T q = -i omega q, i.e. q^H A = i omega q^H.
+template <class Matrix>
+eigen_pair inverse_power_adjoint(const Matrix& a, std::complex<double> shift, const inverse_power_options& opt = {},
+                                 const vec<std::complex<double>>* start = nullptr) {
+  const Matrix at = a.transpose();
+  return internal::inverse_power_impl(at, std::conj(shift), opt, start, "adjoint inverse power");
+}
+
+}  // namespace aerohopf
