@@ -10,6 +10,8 @@
 //    degenerates into exact equality);
 //  * sqrt, exp, log, pow, abs, isfinite are QD's own free functions in the global namespace,
 //    found by argument-dependent lookup from generic code that writes `using std::sqrt;`.
+// Dense factorisations: PartialPivLU and HouseholderQR work; Eigen's FullPivLU does not compile
+// (it forms RealScalar(Index), ambiguous between QD's int and double constructors).
 // QD arithmetic relies on exactly rounded IEEE operations: never compile it with -ffast-math,
 // and keep FMA contraction off (the aerohopf target adds -ffp-contract=off).
 #include <Eigen/Core>
@@ -23,7 +25,7 @@ namespace aerohopf {
 template <>
 struct scalar_traits<dd_real> {
   static constexpr std::string_view name() { return "dd"; }
-  static constexpr double epsilon() { return 4.93038065763132e-32; }  // 2^-104
+  static constexpr double epsilon() { return 0x1p-104; }  // exact power of two (QD's _eps is a rounded decimal)
   static constexpr int digits10 = 31;
   static double to_double(const dd_real& x) { return x.x[0]; }
 };
@@ -31,7 +33,7 @@ struct scalar_traits<dd_real> {
 template <>
 struct scalar_traits<qd_real> {
   static constexpr std::string_view name() { return "qd"; }
-  static constexpr double epsilon() { return 1.21543267145725e-63; }  // 2^-209
+  static constexpr double epsilon() { return 0x1p-209; }
   static constexpr int digits10 = 62;
   static double to_double(const qd_real& x) { return x.x[0]; }
 };
