@@ -69,6 +69,11 @@ class hopf_normal_form {
   const Eigen::MatrixXd& basis() const { return t_; }          ///< T (w = T u)
   const Eigen::MatrixXd& basis_inverse() const { return t_inv_; }  ///< T^{-1} as used by f
   const Eigen::VectorXd& decay_rates() const { return d_; }    ///< d_k (eigenvalues -d_k)
+  /// (a_k, b_k, c_k) of y_k' = -d_k y_k + a_k x1^2 + b_k x1 x2 + c_k x2^2.
+  Eigen::Vector3d y_forcing(int k) const {
+    require(k >= 0 && k < m_, "hopf_normal_form::y_forcing: index ", k, " out of range [0, ", m_, ")");
+    return {a_[k], b_[k], c_[k]};
+  }
 
   /// Exact right eigenvector at the Hopf point, A p = i p, <p, p> = 1, z = x1 + i x2.
   vec<std::complex<double>> exact_p() const {

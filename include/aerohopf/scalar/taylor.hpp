@@ -92,6 +92,21 @@ class taylor {
     return *this;
   }
 
+  // Built-in constants (x *= 2 with T = dd_real would otherwise be ambiguous between the T and
+  // taylor overloads); the constant goes through double, which is exact for every T.
+  template <class U>
+    requires(std::is_arithmetic_v<U> && !std::is_same_v<U, T>)
+  taylor& operator+=(U b) { return *this += T(static_cast<double>(b)); }
+  template <class U>
+    requires(std::is_arithmetic_v<U> && !std::is_same_v<U, T>)
+  taylor& operator-=(U b) { return *this -= T(static_cast<double>(b)); }
+  template <class U>
+    requires(std::is_arithmetic_v<U> && !std::is_same_v<U, T>)
+  taylor& operator*=(U b) { return *this *= T(static_cast<double>(b)); }
+  template <class U>
+    requires(std::is_arithmetic_v<U> && !std::is_same_v<U, T>)
+  taylor& operator/=(U b) { return *this /= T(static_cast<double>(b)); }
+
   taylor operator-() const {
     taylor r;
     for (int k = 0; k <= K; ++k) r.c_[k] = -c_[k];
@@ -198,6 +213,19 @@ class taylor {
     requires(std::is_arithmetic_v<U> && !std::is_same_v<U, T>)
   friend bool operator!=(const taylor& a, U b) { return a.c_[0] != T(static_cast<double>(b)); }
 
+  template <class U>
+    requires(std::is_arithmetic_v<U> && !std::is_same_v<U, T>)
+  friend bool operator<(U a, const taylor& b) { return T(static_cast<double>(a)) < b.c_[0]; }
+  template <class U>
+    requires(std::is_arithmetic_v<U> && !std::is_same_v<U, T>)
+  friend bool operator>(U a, const taylor& b) { return T(static_cast<double>(a)) > b.c_[0]; }
+  template <class U>
+    requires(std::is_arithmetic_v<U> && !std::is_same_v<U, T>)
+  friend bool operator<=(U a, const taylor& b) { return T(static_cast<double>(a)) <= b.c_[0]; }
+  template <class U>
+    requires(std::is_arithmetic_v<U> && !std::is_same_v<U, T>)
+  friend bool operator>=(U a, const taylor& b) { return T(static_cast<double>(a)) >= b.c_[0]; }
+
   friend std::ostream& operator<<(std::ostream& os, const taylor& a) {
     os << "[";
     for (int k = 0; k <= K; ++k) os << (k ? ", " : "") << a.c_[k];
@@ -286,16 +314,17 @@ taylor<T, K> log(const taylor<T, K>& a) {
   return l;
 }
 
-/// a^r for a real exponent r; a_0 must be positive unless r is a non-negative integer.
+template <class T, int K>
+taylor<T, K> pow(const taylor<T, K>& a, int n);
+
+/// a^r for a real exponent r; a_0 must be positive unless r is an integer. Integer r (|r| <= 64)
+/// takes the repeated-multiplication path, so negative and zero bases work there.
 template <class T, int K>
 taylor<T, K> pow(const taylor<T, K>& a, const T& r) {
+  using std::abs;
   using std::floor;
   using std::pow;
-  if (a[0] == T(0.0) && r >= T(0.0) && floor(r) == r && r < T(64.0)) {
-    taylor<T, K> p(T(1.0));
-    for (int i = 0; i < static_cast<int>(aerohopf::to_double(r)); ++i) p = p * a;
-    return p;
-  }
+  if (floor(r) == r && abs(r) <= T(64.0)) return pow(a, static_cast<int>(aerohopf::to_double(r)));
   taylor<T, K> p;
   p[0] = pow(a[0], r);
   for (int k = 1; k <= K; ++k) {
@@ -392,14 +421,32 @@ taylor<T, K> atan2(const taylor<T, K>& y, const taylor<T, K>& x) {
 }
 template <class T, int K>
 taylor<T, K> tanh(const taylor<T, K>& a) {
-  const auto e = exp(a + a);
-  return (e - T(1.0)) / (e + T(1.0));
+  using std::cosh;
+  using std::tanh;
+  // th' = u a' with u = 1 - th^2. Not (e^{2a} - 1)/(e^{2a} + 1), which overflows to NaN for
+  // large |a|; u_0 = sech^2(a_0) avoids the cancellation in 1 - th_0^2 when |th_0| ~ 1.
+  taylor<T, K> th, u;
+  th[0] = tanh(a[0]);
+  const T sech = T(1.0) / cosh(a[0]);
+  u[0] = sech * sech;
+  for (int k = 1; k <= K; ++k) {
+    if (k >= 2) {  // u_{k-1} = -sum_{i=0..k-1} th_i th_{k-1-i}
+      T acc = T(0.0);
+      for (int i = 0; i <= k - 1; ++i) acc += th[i] * th[k - 1 - i];
+      u[k - 1] = -acc;
+    }
+    T acc = T(0.0);
+    for (int j = 1; j <= k; ++j) acc += internal::kconst<T>(j) * a[j] * u[k - j];
+    th[k] = acc / internal::kconst<T>(k);
+  }
+  return th;
 }
 
+// By value (not std::min's reference), so min(x * x, y) cannot leave a dangling reference.
 template <class T, int K>
-const taylor<T, K>& min(const taylor<T, K>& a, const taylor<T, K>& b) { return b < a ? b : a; }
+taylor<T, K> min(const taylor<T, K>& a, const taylor<T, K>& b) { return b < a ? b : a; }
 template <class T, int K>
-const taylor<T, K>& max(const taylor<T, K>& a, const taylor<T, K>& b) { return a < b ? b : a; }
+taylor<T, K> max(const taylor<T, K>& a, const taylor<T, K>& b) { return a < b ? b : a; }
 template <class T, int K>
 taylor<T, K> fmin(const taylor<T, K>& a, const taylor<T, K>& b) { return min(a, b); }
 template <class T, int K>

@@ -1,0 +1,8 @@
+#pragma once
+// Umbrella header of the bifurcation layer.
+#include "bifurcation/cayley.hpp"
+#include "bifurcation/continuation.hpp"
+#include "bifurcation/hopf.hpp"
+#include "bifurcation/hopf_point.hpp"
+#include "bifurcation/inverse_power.hpp"
+#include "bifurcation/root_locus.hpp"

@@ -1,0 +1,4 @@
+#pragma once
+// Umbrella header of the nonlinear layer.
+#include "nonlinear/newton.hpp"
+#include "nonlinear/system.hpp"

@@ -1,0 +1,227 @@
+#pragma once
+// The Newton family for F(x) = 0 (spec 02), all sharing one engine and one report:
+//
+//  * newton                 exact Jacobian every step; quadratic near a regular root
+//  * newton_chord           Jacobian factored once at the first iterate; linear convergence
+//  * pseudo_transient_newton  (I/dt - A) dx = F with dt ramped by switched evolution relaxation
+//                           dt_k = dt_0 ||F_0|| / ||F_k|| (capped), recovering Newton as dt -> inf.
+//                           This is how the CFD steady solver works; A may be an approximate
+//                           (e.g. modified-order) Jacobian while F is the exact residual.
+//  * broyden                rank-one updates A+ = A + (y - A s) s^T / (s.s) of a dense matrix.
+//                           It destroys sparsity, and the final A is NOT the true Jacobian (never
+//                           use it for eigenvalues).
+//
+// The engine (newton_iterate) works on any residual/Jacobian callables, so the equilibrium
+// problem, the pseudo-arclength corrector and the augmented Hopf systems all use it.
+//
+// Convergence criterion (stated, checked, reported): ||F(x_k)||_2 <= abs_tolerance +
+// rel_tolerance ||F(x_0)||_2. Failure modes, all thrown as convergence_error naming the
+// iterate and residual unless throw_on_failure is false: non-finite residual or step,
+// growth beyond divergence_factor ||F(x_0)||, iteration limit. Under-relaxation: steps are
+// scaled by `relaxation` until ||F|| has dropped below relax_until ||F_0||, then full steps
+// (the start-up strategy reported for the augmented Hopf system); an optional backtracking
+// line search halves a step that does not decrease ||F||.
+#include <Eigen/Core>
+
+#include <chrono>
+#include <cmath>
+#include <functional>
+#include <iomanip>
+#include <iostream>
+#include <string>
+#include <vector>
+
+#include "../error.hpp"
+#include "../linalg/direct.hpp"
+#include "system.hpp"
+
+namespace aerohopf {
+
+struct newton_step_info {
+  int iteration = 0;
+  double residual = 0;      ///< ||F(x)||_2 after the step
+  double step = 0;          ///< ||dx||_2 of the step taken
+  double relaxation = 1;    ///< factor applied to the step
+  const vec<double>* x = nullptr;
+};
+
+struct newton_options {
+  double abs_tolerance = 1e-10;
+  double rel_tolerance = 0.0;
+  int max_iterations = 50;
+  double divergence_factor = 1e10;
+  double relaxation = 1.0;     ///< initial step scaling psi in (0, 1]
+  double relax_until = 0.5;    ///< use psi until ||F|| < relax_until ||F_0||, then full steps
+  bool line_search = false;    ///< halve the step (up to 10 times) while ||F|| does not decrease
+  bool throw_on_failure = true;
+  std::function<void(const newton_step_info&)> observer;  ///< called after every step
+};
+
+struct newton_report {
+  bool converged = false;
+  std::string reason;
+  int iterations = 0;
+  std::vector<double> residual_history;  ///< ||F||_2 at x_0, x_1, ...
+  std::vector<double> step_history;
+  double seconds = 0;
+  double final_residual() const { return residual_history.empty() ? NAN : residual_history.back(); }
+};
+
+struct newton_result {
+  vec<double> x;
+  newton_report report;
+};
+
+/// Progress printer for newton_options::observer.
+inline std::function<void(const newton_step_info&)> newton_progress(std::string label, std::ostream& os = std::cout) {
+  return [label = std::move(label), &os](const newton_step_info& s) {
+    os << label << " it " << std::setw(3) << s.iteration << "  |F| " << std::scientific << std::setprecision(3)
+       << s.residual << "  |dx| " << s.step << std::defaultfloat << std::setprecision(6)
+       << (s.relaxation < 1 ? "  relaxed " + std::to_string(s.relaxation) : std::string()) << "\n";
+  };
+}
+
+namespace internal {
+inline double norm_or_nan(const vec<double>& v) { return v.allFinite() ? v.norm() : NAN; }
+}  // namespace internal
+
+/// Generic Newton-type iteration. `residual(x)` returns F(x); `solve_step(x, F, k)` returns the
+/// correction dx with (approximately) J(x) dx = -F. `what` names the problem in messages.
+template <class ResidualFn, class StepFn>
+newton_result newton_iterate(ResidualFn&& residual, StepFn&& solve_step, vec<double> x, const newton_options& opt,
+                             const std::string& what) {
+  const auto t0 = std::chrono::steady_clock::now();
+  newton_result res;
+  auto& rep = res.report;
+  auto fail = [&](const std::string& why) {
+    rep.converged = false;
+    rep.reason = why;
+    rep.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    if (opt.throw_on_failure) throw convergence_error(what + ": " + why);
+    res.x = x;
+    return res;
+  };
+  for (Eigen::Index i = 0; i < x.size(); ++i)
+    require(std::isfinite(x[i]), what, ": initial iterate entry ", i, " is not finite");
+  vec<double> f = residual(x);
+  double fn = internal::norm_or_nan(f);
+  if (!std::isfinite(fn)) return fail("residual at the initial iterate is not finite");
+  rep.residual_history.push_back(fn);
+  const double f0 = fn;
+  const double target = opt.abs_tolerance + opt.rel_tolerance * f0;
+  bool relaxing = opt.relaxation < 1.0;
+  for (int k = 1;; ++k) {
+    if (fn <= target) {
+      rep.converged = true;
+      rep.reason = internal::concat("||F|| = ", fn, " <= ", target, " after ", rep.iterations, " iterations");
+      break;
+    }
+    if (k > opt.max_iterations)
+      return fail(internal::concat("no convergence in ", opt.max_iterations, " iterations (||F|| = ", fn,
+                                   ", target ", target, ")"));
+    vec<double> dx = solve_step(x, f, k);
+    const double dxn = internal::norm_or_nan(dx);
+    if (!std::isfinite(dxn)) return fail(internal::concat("Newton step ", k, " is not finite (||F|| = ", fn, ")"));
+    double psi = relaxing ? opt.relaxation : 1.0;
+    vec<double> xn = x + psi * dx;
+    vec<double> fnew = residual(xn);
+    double fnn = internal::norm_or_nan(fnew);
+    if (opt.line_search) {
+      for (int h = 0; h < 10 && !(fnn < fn); ++h) {
+        psi *= 0.5;
+        xn = x + psi * dx;
+        fnew = residual(xn);
+        fnn = internal::norm_or_nan(fnew);
+      }
+    }
+    if (!std::isfinite(fnn)) return fail(internal::concat("residual not finite at iterate ", k));
+    x = std::move(xn);
+    f = std::move(fnew);
+    fn = fnn;
+    rep.iterations = k;
+    rep.residual_history.push_back(fn);
+    rep.step_history.push_back(psi * dxn);
+    if (relaxing && fn < opt.relax_until * f0) relaxing = false;
+    if (opt.observer) opt.observer({k, fn, psi * dxn, psi, &x});
+    if (fn > opt.divergence_factor * std::max(f0, 1e-300))
+      return fail(internal::concat("diverged at iterate ", k, " (||F|| = ", fn, " from ", f0, ")"));
+  }
+  rep.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  res.x = std::move(x);
+  return res;
+}
+
+/// Newton with the exact Jacobian of the system at fixed mu.
+template <system S>
+newton_result newton(const S& s, const vec<double>& w0, double mu, const newton_options& opt = {}) {
+  check_state(s, w0, mu, "newton");
+  direct_solver<jacobian_t<S>> lu("newton: Jacobian");
+  return newton_iterate([&](const vec<double>& w) { return vec<double>(s.residual(w, mu)); },
+                        [&](const vec<double>& w, const vec<double>& f, int) {
+                          lu.compute(s.jacobian(w, mu));
+                          return vec<double>(-lu.solve(f));
+                        },
+                        w0, opt, "newton (equilibrium)");
+}
+
+/// Newton chord: the Jacobian at w0 is factored once.
+template <system S>
+newton_result newton_chord(const S& s, const vec<double>& w0, double mu, const newton_options& opt = {}) {
+  check_state(s, w0, mu, "newton_chord");
+  direct_solver<jacobian_t<S>> lu("newton_chord: Jacobian");
+  lu.compute(lhs_jacobian(s, w0, mu));
+  return newton_iterate([&](const vec<double>& w) { return vec<double>(s.residual(w, mu)); },
+                        [&](const vec<double>&, const vec<double>& f, int) { return vec<double>(-lu.solve(f)); },
+                        w0, opt, "newton chord (equilibrium)");
+}
+
+struct pseudo_transient_options {
+  double dt0 = 1e-1;     ///< initial pseudo time step
+  double dt_max = 1e12;  ///< cap; dt -> inf recovers Newton
+  double ser_exponent = 1.0;  ///< dt_k = dt0 (||F_0|| / ||F_k||)^exponent
+};
+
+/// Pseudo-transient (relaxed) Newton: (I/dt - A) dw = f with the left-hand-side Jacobian (the
+/// approximate one if the system provides it) and switched evolution relaxation of dt.
+template <system S>
+newton_result pseudo_transient_newton(const S& s, const vec<double>& w0, double mu, const newton_options& opt = {},
+                                      const pseudo_transient_options& pto = {}) {
+  check_state(s, w0, mu, "pseudo_transient_newton");
+  direct_solver<jacobian_t<S>> lu("pseudo-transient Newton: I/dt - A");
+  double f0 = -1;
+  return newton_iterate([&](const vec<double>& w) { return vec<double>(s.residual(w, mu)); },
+                        [&](const vec<double>& w, const vec<double>& f, int) {
+                          const double fn = f.norm();
+                          if (f0 < 0) f0 = fn;
+                          const double dt = std::min(pto.dt_max, pto.dt0 * std::pow(f0 / fn, pto.ser_exponent));
+                          jacobian_t<S> m = lhs_jacobian(s, w, mu);
+                          jacobian_t<S> lhs = identity_like<double>(m) * (1.0 / dt) - m;
+                          lu.compute(lhs);
+                          return vec<double>(lu.solve(f));
+                        },
+                        w0, opt, "pseudo-transient newton (equilibrium)");
+}
+
+/// Broyden's good method on a dense approximation started from the left-hand-side Jacobian at w0.
+template <system S>
+newton_result broyden(const S& s, const vec<double>& w0, double mu, const newton_options& opt = {}) {
+  check_state(s, w0, mu, "broyden");
+  Eigen::MatrixXd a = Eigen::MatrixXd(lhs_jacobian(s, w0, mu));
+  vec<double> w_prev, f_prev;
+  direct_solver<Eigen::MatrixXd> lu("broyden: Jacobian approximation");
+  return newton_iterate([&](const vec<double>& w) { return vec<double>(s.residual(w, mu)); },
+                        [&](const vec<double>& w, const vec<double>& f, int k) {
+                          if (k > 1) {
+                            const vec<double> sv = w - w_prev, y = f - f_prev;
+                            const double ss = sv.squaredNorm();
+                            if (ss > 0) a += (y - a * sv) * sv.transpose() / ss;
+                          }
+                          w_prev = w;
+                          f_prev = f;
+                          lu.compute(a);
+                          return vec<double>(-lu.solve(f));
+                        },
+                        w0, opt, "broyden (equilibrium)");
+}
+
+}  // namespace aerohopf
