@@ -1,0 +1,6 @@
+#pragma once
+// Umbrella header of the time layer: fixed-step RK4 and implicit BDF2 (with dual time) for
+// verification runs against the reduced models.
+#include "time/bdf2.hpp"
+#include "time/history.hpp"
+#include "time/runge_kutta.hpp"

@@ -1,0 +1,132 @@
+#pragma once
+// Implicit second-order backward differences (BDF2) for dw/dt = f(w, mu) at fixed mu: the
+// time-marching reference of the original work (verification runs of LCOs and of the
+// damping below the flutter point).
+//
+// Each physical step solves the unsteady residual
+//     R(w) = (3 w - 4 w^n + w^{n-1}) / (2 dt) - f(w, mu) = 0     (BDF2)
+//     R(w) = (w - w^n) / dt - f(w, mu) = 0                        (first step: BDF1)
+// by inner Newton iterations on the exact Jacobian, (c I - A(w)) dw = -R(w) with c = 3/(2 dt)
+// (or 1/dt), through direct_solver of the system's jacobian_type, so dense and sparse systems
+// work unchanged. BDF2 is A-stable, so dt is set by accuracy, not by the stiff modes.
+//
+// Dual (pseudo) time: with pseudo_dt > 0 each inner iteration is a pseudo-time step
+//     (1/pseudo_dt + c) I - A) dw = -R(w),
+// which is how CFD codes drive the unsteady residual to zero (robust far from the solution,
+// linear instead of quadratic inner convergence). pseudo_dt = 0 is plain Newton.
+//
+// Inner convergence: ||dw||_inf <= inner_tolerance * (1 + ||w||_inf). If it is not reached in
+// max_inner_iterations, convergence_error names the time step, time, iterations and residual.
+#include <Eigen/Core>
+
+#include <cmath>
+#include <string>
+#include <utility>
+
+#include "../error.hpp"
+#include "../linalg/direct.hpp"
+#include "../nonlinear/system.hpp"
+#include "history.hpp"
+
+namespace aerohopf {
+
+struct bdf2_options {
+  double dt = 0.01;
+  double inner_tolerance = 1e-10;  ///< on ||dw||_inf / (1 + ||w||_inf)
+  int max_inner_iterations = 20;
+  double pseudo_dt = 0;            ///< > 0: dual-time inner iterations with this pseudo step
+};
+
+/// What the observer sees after each physical step.
+struct bdf2_step_info {
+  long step = 0;                ///< 0 = initial state
+  double t = 0;
+  int inner_iterations = 0;
+  double inner_residual = 0;    ///< ||R(w)||_inf at the accepted iterate (before the last update)
+};
+
+/// Integrates from w0 at t0 to t_end; calls observer(const bdf2_step_info&, const vec<double>& w)
+/// at the start and after every step; returns w(t_end).
+template <system S, class Observer>
+vec<double> integrate_bdf2(const S& s, double mu, vec<double> w0, double t0, double t_end, const bdf2_options& opt,
+                           Observer&& observer) {
+  const char* who = "integrate_bdf2";
+  check_state(s, w0, mu, who);
+  const long steps = internal::step_count(t0, t_end, opt.dt, who);
+  require(std::isfinite(opt.inner_tolerance) && opt.inner_tolerance > 0, who,
+          ": inner_tolerance must be positive (got ", opt.inner_tolerance, ")");
+  require(opt.max_inner_iterations >= 1, who, ": max_inner_iterations must be >= 1 (got ", opt.max_inner_iterations, ")");
+  require(std::isfinite(opt.pseudo_dt) && opt.pseudo_dt >= 0, who, ": pseudo_dt must be >= 0 (got ", opt.pseudo_dt, ")");
+  const double h = steps > 0 ? (t_end - t0) / double(steps) : 0.0;
+
+  using matrix = jacobian_t<S>;
+  direct_solver<matrix> solver(std::string(who) + ": inner Newton matrix");
+  vec<double> w_prev = w0, w = std::move(w0);
+  bdf2_step_info info;
+  info.t = t0;
+  observer(static_cast<const bdf2_step_info&>(info), static_cast<const vec<double>&>(w));
+
+  for (long n = 1; n <= steps; ++n) {
+    const bool first = n == 1;
+    const double c = first ? 1.0 / h : 1.5 / h;
+    const double shift = c + (opt.pseudo_dt > 0 ? 1.0 / opt.pseudo_dt : 0.0);
+    // History part of the unsteady residual: R(x) = c x - hist - f(x).
+    const vec<double> hist = first ? vec<double>(w / h) : vec<double>((4.0 * w - w_prev) / (2.0 * h));
+    vec<double> x = first ? w : vec<double>(2.0 * w - w_prev);  // linear extrapolation as guess
+    bool converged = false;
+    double rnorm = 0, dnorm = 0;
+    int it = 0;
+    while (it < opt.max_inner_iterations) {
+      ++it;
+      const vec<double> r = c * x - hist - s.residual(x, mu);
+      rnorm = r.template lpNorm<Eigen::Infinity>();
+      if (!std::isfinite(rnorm)) break;
+      const matrix a = s.jacobian(x, mu);
+      const matrix lhs = matrix(identity_like<double>(a) * shift) - a;
+      solver.compute(lhs);
+      const vec<double> dx = solver.solve(vec<double>(-r));
+      x += dx;
+      dnorm = dx.template lpNorm<Eigen::Infinity>();
+      if (dnorm <= opt.inner_tolerance * (1.0 + x.template lpNorm<Eigen::Infinity>())) {
+        converged = true;
+        break;
+      }
+    }
+    if (!converged || !x.allFinite())
+      throw convergence_error(internal::concat(who, ": inner ", opt.pseudo_dt > 0 ? "dual-time" : "Newton",
+                                               " iteration failed at time step ", n, " (t = ", t0 + double(n) * h,
+                                               ") after ", it, " iterations: ||R||_inf = ", rnorm,
+                                               ", last ||dw||_inf = ", dnorm));
+    w_prev = std::move(w);
+    w = std::move(x);
+    info.step = n;
+    info.t = t0 + double(n) * h;
+    info.inner_iterations = it;
+    info.inner_residual = rnorm;
+    observer(static_cast<const bdf2_step_info&>(info), static_cast<const vec<double>&>(w));
+  }
+  return w;
+}
+
+template <system S>
+vec<double> integrate_bdf2(const S& s, double mu, vec<double> w0, double t0, double t_end, const bdf2_options& opt) {
+  return integrate_bdf2(s, mu, std::move(w0), t0, t_end, opt, [](const bdf2_step_info&, const vec<double>&) {});
+}
+
+/// BDF2 run storing every store_every-th step (and always the first and the last).
+template <system S>
+time_history<vec<double>> bdf2_history(const S& s, double mu, vec<double> w0, double t0, double t_end,
+                                       const bdf2_options& opt, long store_every = 1) {
+  require(store_every >= 1, "bdf2_history: store_every must be >= 1 (got ", store_every, ")");
+  const long steps = internal::step_count(t0, t_end, opt.dt, "bdf2_history");
+  time_history<vec<double>> hist;
+  integrate_bdf2(s, mu, std::move(w0), t0, t_end, opt, [&](const bdf2_step_info& info, const vec<double>& w) {
+    if (info.step % store_every == 0 || info.step == steps) {
+      hist.t.push_back(info.t);
+      hist.y.push_back(w);
+    }
+  });
+  return hist;
+}
+
+}  // namespace aerohopf
