@@ -290,6 +290,12 @@ TYPED_TEST(TaylorTyped, AbsMinMaxFollowTheValueBranch) {
   EXPECT_TRUE(m[0] == T(1.0) && m[1] == T(-3.0));
   EXPECT_TRUE(min(x * x, y)[1] == T(-2.0));
   EXPECT_FALSE(isnan(x));
+  // sqrt of an identically zero jet (norm of a zero vector) is zero, not NaN.
+  const J zero_root = sqrt(J(T(0.0)));
+  EXPECT_TRUE(isfinite(zero_root) && zero_root[0] == T(0.0) && zero_root[3] == T(0.0));
+  const Eigen::Matrix<J, 3, 1> zero_vector = Eigen::Matrix<J, 3, 1>::Zero();
+  EXPECT_TRUE(isfinite(zero_vector.norm()) && zero_vector.norm()[1] == T(0.0));
+  EXPECT_FALSE(isfinite(sqrt(J::variable(T(0.0)))));  // sqrt(t): not differentiable
   EXPECT_TRUE(isnan(J::variable(Eigen::NumTraits<T>::quiet_NaN())));
   EXPECT_TRUE(isinf(J::variable(Eigen::NumTraits<T>::infinity())));
   EXPECT_FALSE(isinf(J::variable(T(1.0))));

@@ -18,6 +18,24 @@
 // Comparisons look at the value c_0 only, so branches in a residual (limiters, upwinding,
 // min/max) follow the branch the plain evaluation takes and the jet differentiates that
 // branch, exactly as a directional derivative of the piecewise-smooth function would.
+//
+// Usage (the whole public API):
+//   using J = taylor<double, 3>;
+//   J x = J::variable(x0, dx);          // x0 + dx t
+//   J y = f(x);                         // any generic f: `using std::exp; exp(x)` finds
+//                                       // aerohopf::exp by ADL, as do sqrt, log, pow, abs, ...
+//   y[k] or y.value() == y[0];          // Taylor coefficient: d^k/dt^k f(x0 + dx t) / k!
+//   y.derivative(k) == k! * y[k];
+// Constants: jet * 2, 2.0 * jet, jet / 3, 1 - jet, jet < 0.5 work for every T; built-in constants
+// go through double, which is exact. For T = dd_real / qd_real write non-dyadic constants as
+// ratios in T (T(1.0) / T(3.0)), never as decimal double literals, or the residual is only
+// double-accurate. Beware QD's own pow(qd_real, int): pow(x, 1.5) on a plain qd_real silently
+// computes x^1; on jets the real exponent is kept.
+// Eigen: Matrix<taylor<T, K>, ...> works (NumTraits below): arithmetic, norm, PartialPivLU,
+// FullPivLU (tested with T = double), inverse; matrix * scalar works for scalars of type
+// taylor<T, K> and T (not double when T is dd_real / qd_real).
+// Non-smooth points: abs/min/max/comparisons follow the branch of the value (see above); sqrt,
+// log and non-integer pow at value 0 give inf/NaN coefficients (an all-zero sqrt gives 0).
 #include <Eigen/Core>
 
 #include <array>
@@ -277,6 +295,13 @@ template <class T, int K>
 taylor<T, K> sqrt(const taylor<T, K>& a) {
   using std::sqrt;
   taylor<T, K> s;
+  if (a[0] == T(0.0)) {
+    // sqrt of an identically zero jet (e.g. the norm of a zero vector) is zero; otherwise the
+    // square root is not differentiable at 0 and the recurrence below yields inf/NaN.
+    bool all_zero = true;
+    for (int k = 1; k <= K; ++k) all_zero = all_zero && a[k] == T(0.0);
+    if (all_zero) return s;
+  }
   s[0] = sqrt(a[0]);
   const T two_s0 = s[0] + s[0];
   for (int k = 1; k <= K; ++k) {
@@ -508,6 +533,7 @@ struct NumTraits<aerohopf::taylor<T, K>> : GenericNumTraits<aerohopf::taylor<T, 
   static inline Self infinity() { return Self(NumTraits<T>::infinity()); }
   static inline Self quiet_NaN() { return Self(NumTraits<T>::quiet_NaN()); }
   static inline int digits10() { return NumTraits<T>::digits10(); }
+  static inline int digits() { return NumTraits<T>::digits(); }
 };
 
 template <class T, int K, class BinaryOp>
