@@ -1,0 +1,395 @@
+#pragma once
+// Preconditioned Krylov methods for the non-symmetric (real or complex) systems of spec 07:
+// GCR(m), GMRES(m), TFQMR and BiCGSTAB, all RIGHT-preconditioned (A M^{-1} u = b, x = M^{-1} u)
+// so the residual they minimise or monitor is the true, unpreconditioned one, comparable
+// across preconditioners and forms.
+//
+// WHY several methods: the original work used GCR (one operator product per step, cheap
+// restarts) and Aztec's GMRES/TFQMR; GMRES minimises the residual at the price of the Arnoldi
+// basis; TFQMR and BiCGSTAB use O(1) vectors (memory matters at a million cells, complex).
+//
+//   krylov_options opt;  opt.relative_tolerance = 1e-8;  opt.restart = 60;
+//   krylov_report rep = gmres(A, M, b, x, opt);   // x: initial guess in, solution out
+// A: any linear_operator (operator.hpp): block_sparse_matrix, Eigen matrix, lambda,
+// shifted_operator, bordered_operator. M: identity_preconditioner{}, block_ilu, ... .
+// Scalar: from b; complex scalars use the conjugating inner product <u, v> = sum conj(u_i) v_i.
+// Convergence: ||b - A x|| <= max(relative_tolerance * ||b||, absolute_tolerance), judged on
+// the TRUE residual (recomputed at restarts and at the end; reported as relative_residual).
+// Failure is returned in the report (converged = false, reason); with throw_on_failure a
+// convergence_error with the context, method, iteration and residual is thrown instead.
+//
+// Iteration counts: GCR/GMRES count one step per operator product; TFQMR and BiCGSTAB count
+// one iteration per TWO operator products (operator_applications gives the comparable cost).
+#include <Eigen/Core>
+
+#include <cmath>
+#include <complex>
+#include <string>
+#include <vector>
+
+#include "../error.hpp"
+#include "../scalar/complex.hpp"
+#include "operator.hpp"
+
+namespace aerohopf {
+
+struct krylov_options {
+  double relative_tolerance = 1e-8;  ///< on ||b - A x|| / ||b||
+  double absolute_tolerance = 0.0;   ///< on ||b - A x||
+  int max_iterations = 1000;         ///< Krylov iterations in total (over restarts)
+  int restart = 60;                  ///< m of GCR(m) and GMRES(m)
+  bool throw_on_failure = false;     ///< throw convergence_error instead of returning a failed report
+  bool record_history = true;        ///< keep the residual history
+  std::string context = "Krylov";    ///< prefix of error messages
+};
+
+struct krylov_report {
+  std::string method;
+  bool converged = false;
+  std::string reason;                   ///< why the iteration stopped
+  int iterations = 0;
+  int operator_applications = 0;
+  int preconditioner_applications = 0;
+  double rhs_norm = 0.0;                ///< ||b||
+  double initial_residual = 0.0;        ///< ||b - A x0|| / ||b||
+  double relative_residual = 0.0;       ///< final TRUE ||b - A x|| / ||b||
+  std::vector<double> residual_history; ///< relative residual (estimate) after each iteration, [0] initial
+};
+
+namespace internal {
+
+/// Shared bookkeeping of the four methods: counting, history, stopping test, final report.
+template <class S, class Op, class Pre>
+struct krylov_state {
+  using real = real_of_t<S>;
+  const Op& a;
+  const Pre& m;
+  const vec<S>& b;
+  vec<S>& x;
+  const krylov_options& opt;
+  krylov_report rep;
+  double target = 0.0;
+
+  krylov_state(const char* name, const Op& a_, const Pre& m_, const vec<S>& b_, vec<S>& x_, const krylov_options& o)
+      : a(a_), m(m_), b(b_), x(x_), opt(o) {
+    rep.method = name;
+    require(opt.max_iterations >= 0 && opt.restart >= 1 && opt.relative_tolerance >= 0 && opt.absolute_tolerance >= 0,
+            opt.context, ": ", name, ": invalid options (max_iterations ", opt.max_iterations, ", restart ",
+            opt.restart, ", tolerances ", opt.relative_tolerance, ", ", opt.absolute_tolerance, ")");
+    if (x.size() == 0) x = vec<S>::Zero(b.size());
+    require(x.size() == b.size(), opt.context, ": ", name, ": initial guess has ", x.size(), " entries, rhs ",
+            b.size());
+    rep.rhs_norm = static_cast<double>(b.norm());
+    require(std::isfinite(rep.rhs_norm), opt.context, ": ", name, ": right-hand side is not finite");
+    target = std::max(opt.relative_tolerance * rep.rhs_norm, opt.absolute_tolerance);
+  }
+  double scale() const { return rep.rhs_norm > 0 ? rep.rhs_norm : 1.0; }
+  void op(const vec<S>& in, vec<S>& out) {
+    apply_operator<S>(a, in, out);
+    ++rep.operator_applications;
+  }
+  void pre(const vec<S>& in, vec<S>& out) {
+    apply_operator<S>(m, in, out);
+    ++rep.preconditioner_applications;
+  }
+  /// r = b - A x; returns ||r||.
+  double true_residual(vec<S>& r, vec<S>& tmp) {
+    op(x, tmp);
+    r = b - tmp;
+    return static_cast<double>(r.norm());
+  }
+  void record(double rnorm) {
+    if (opt.record_history) rep.residual_history.push_back(rnorm / scale());
+  }
+  bool out_of_iterations() const { return rep.iterations >= opt.max_iterations; }
+  /// Final true residual, reason and (optionally) throw.
+  krylov_report finish(vec<S>& r, vec<S>& tmp, std::string reason) {
+    const double rn = true_residual(r, tmp);
+    rep.relative_residual = rn / scale();
+    rep.converged = std::isfinite(rn) && rn <= target * (1 + 1e-10);
+    if (rep.converged) reason = "converged";
+    else if (reason.empty()) reason = out_of_iterations() ? "maximum number of iterations reached" : "stopped";
+    rep.reason = reason;
+    if (!rep.converged && opt.throw_on_failure)
+      throw convergence_error(concat(opt.context, ": ", rep.method, " did not converge (", rep.reason, ") after ",
+                                     rep.iterations, " iterations, relative residual ", rep.relative_residual,
+                                     ", target ", target / scale()));
+    return rep;
+  }
+};
+
+}  // namespace internal
+
+/// Right-preconditioned restarted GMRES(m) (Arnoldi with modified Gram-Schmidt, complex Givens
+/// rotations). The solution update M^{-1}(V y) is formed once per cycle, so no preconditioned
+/// basis is stored (n (m+1) scalars of memory).
+template <class S, class Op, class Pre>
+krylov_report gmres(const Op& a, const Pre& m_pre, const vec<S>& b, vec<S>& x, const krylov_options& opt = {}) {
+  internal::krylov_state<S, Op, Pre> st("GMRES", a, m_pre, b, x, opt);
+  using real = real_of_t<S>;
+  const Eigen::Index n = b.size();
+  const int m = opt.restart;
+  vec<S> r(n), w(n), z(n);
+  double beta = st.true_residual(r, w);
+  st.rep.initial_residual = beta / st.scale();
+  st.record(beta);
+  Eigen::Matrix<S, Eigen::Dynamic, Eigen::Dynamic> v(n, m + 1), h = Eigen::Matrix<S, Eigen::Dynamic, Eigen::Dynamic>::Zero(m + 1, m);
+  vec<S> g(m + 1), sn(m);
+  Eigen::Matrix<real, Eigen::Dynamic, 1> cs(m);
+  std::string reason;
+  while (true) {
+    if (!std::isfinite(beta)) {
+      reason = "non-finite residual";
+      break;
+    }
+    if (beta <= st.target || st.out_of_iterations()) break;
+    v.col(0) = r / S(beta);
+    g.setZero();
+    g(0) = S(beta);
+    int j = 0;
+    bool breakdown = false;
+    while (j < m && !st.out_of_iterations()) {
+      z = v.col(j);
+      st.pre(z, r);  // r used as scratch: M^{-1} v_j
+      st.op(r, w);
+      for (int i = 0; i <= j; ++i) {
+        h(i, j) = v.col(i).dot(w);
+        w -= h(i, j) * v.col(i);
+      }
+      const real hn = w.norm();
+      for (int i = 0; i < j; ++i) {  // previous rotations
+        const S t = cs(i) * h(i, j) + sn(i) * h(i + 1, j);
+        h(i + 1, j) = -Eigen::numext::conj(sn(i)) * h(i, j) + cs(i) * h(i + 1, j);
+        h(i, j) = t;
+      }
+      // new rotation annihilating hn below h(j, j)
+      const S hjj = h(j, j);
+      const real ah = std::abs(hjj), nu = std::sqrt(ah * ah + hn * hn);
+      if (nu == real(0)) {  // A M^{-1} v_j in span(v_0..v_{j-1}) and h_jj = 0: singular
+        breakdown = true;
+        break;
+      }
+      if (ah == real(0)) {
+        cs(j) = 0;
+        sn(j) = S(1.0);
+      } else {
+        cs(j) = ah / nu;
+        sn(j) = (hjj / ah) * S(hn / nu);
+      }
+      h(j, j) = ah == real(0) ? S(hn) : (hjj / ah) * S(nu);
+      h(j + 1, j) = S(0.0);
+      g(j + 1) = -Eigen::numext::conj(sn(j)) * g(j);
+      g(j) = cs(j) * g(j);
+      ++st.rep.iterations;
+      const double est = static_cast<double>(std::abs(g(j + 1)));
+      st.record(est);
+      ++j;
+      if (!std::isfinite(est)) break;
+      if (hn == real(0)) {
+        breakdown = true;  // invariant subspace: the solution is in the current space
+        break;
+      }
+      if (est <= st.target) break;
+      v.col(j) = w / S(hn);
+    }
+    // y = H^{-1} g; x += M^{-1} V y
+    const vec<S> y = h.topLeftCorner(j, j).template triangularView<Eigen::Upper>().solve(g.head(j));
+    w.noalias() = v.leftCols(j) * y;
+    st.pre(w, z);
+    x += z;
+    beta = st.true_residual(r, w);
+    if (breakdown && beta > st.target) {
+      reason = "breakdown (singular preconditioned operator?)";
+      break;
+    }
+  }
+  return st.finish(r, w, reason);
+}
+
+/// Right-preconditioned restarted GCR(m): u_j = M^{-1} r_j, c_j = A u_j orthonormalised
+/// against the previous c_i (the same combination applied to u), then x += <c_j, r> u_j,
+/// r -= <c_j, r> c_j. One operator product per step; 2m stored vectors.
+template <class S, class Op, class Pre>
+krylov_report gcr(const Op& a, const Pre& m_pre, const vec<S>& b, vec<S>& x, const krylov_options& opt = {}) {
+  internal::krylov_state<S, Op, Pre> st("GCR", a, m_pre, b, x, opt);
+  using real = real_of_t<S>;
+  const Eigen::Index n = b.size();
+  const int m = opt.restart;
+  vec<S> r(n), tmp(n);
+  double rn = st.true_residual(r, tmp);
+  st.rep.initial_residual = rn / st.scale();
+  st.record(rn);
+  Eigen::Matrix<S, Eigen::Dynamic, Eigen::Dynamic> u(n, m), c(n, m);
+  std::string reason;
+  vec<S> uj(n), cj(n);
+  while (reason.empty() && std::isfinite(rn) && rn > st.target && !st.out_of_iterations()) {
+    for (int j = 0; j < m && !st.out_of_iterations(); ++j) {
+      st.pre(r, uj);
+      st.op(uj, cj);
+      for (int i = 0; i < j; ++i) {
+        const S beta = c.col(i).dot(cj);
+        cj -= beta * c.col(i);
+        uj -= beta * u.col(i);
+      }
+      const real nc = cj.norm();
+      if (!(nc > real(0))) {
+        reason = std::isfinite(static_cast<double>(nc)) ? "breakdown (A M^{-1} r = 0)" : "non-finite residual";
+        break;
+      }
+      c.col(j) = cj / S(nc);
+      u.col(j) = uj / S(nc);
+      const S alpha = c.col(j).dot(r);
+      x += alpha * u.col(j);
+      r -= alpha * c.col(j);
+      ++st.rep.iterations;
+      rn = static_cast<double>(r.norm());
+      st.record(rn);
+      if (!std::isfinite(rn)) {
+        reason = "non-finite residual";
+        break;
+      }
+      if (rn <= st.target) break;
+    }
+    if (reason.empty()) rn = st.true_residual(r, tmp);  // restart from the true residual
+  }
+  return st.finish(r, tmp, reason);
+}
+
+/// Right-preconditioned BiCGSTAB (van der Vorst); shadow residual = initial residual.
+template <class S, class Op, class Pre>
+krylov_report bicgstab(const Op& a, const Pre& m_pre, const vec<S>& b, vec<S>& x, const krylov_options& opt = {}) {
+  internal::krylov_state<S, Op, Pre> st("BiCGSTAB", a, m_pre, b, x, opt);
+  const Eigen::Index n = b.size();
+  vec<S> r(n), tmp(n);
+  double rn = st.true_residual(r, tmp);
+  st.rep.initial_residual = rn / st.scale();
+  st.record(rn);
+  std::string reason;
+  vec<S> rhat(n), p(n), v(n), phat(n), s(n), shat(n), t(n);
+  while (reason.empty() && std::isfinite(rn) && rn > st.target && !st.out_of_iterations()) {
+    // (re)start from the current true residual
+    const double cycle_start = rn;
+    rhat = r;
+    S rho(1.0), alpha(1.0), omega(1.0);
+    v.setZero();
+    p.setZero();
+    while (!st.out_of_iterations()) {
+      const S rho_new = rhat.dot(r);
+      if (rho_new == S(0.0)) break;  // restart with a fresh shadow residual
+      const S beta = (rho_new / rho) * (alpha / omega);
+      p = r + beta * (p - omega * v);
+      st.pre(p, phat);
+      st.op(phat, v);
+      const S sigma = rhat.dot(v);
+      if (sigma == S(0.0)) {
+        reason = "breakdown (<r^, A M^{-1} p> = 0)";
+        break;
+      }
+      alpha = rho_new / sigma;
+      s = r - alpha * v;
+      ++st.rep.iterations;
+      const double sn = static_cast<double>(s.norm());
+      if (sn <= st.target) {
+        x += alpha * phat;
+        r = s;
+        rn = sn;
+        st.record(rn);
+        break;
+      }
+      st.pre(s, shat);
+      st.op(shat, t);
+      const double tt = static_cast<double>(t.squaredNorm());
+      omega = tt > 0 ? S(t.dot(s) / S(tt)) : S(0.0);
+      x += alpha * phat + omega * shat;
+      r = s - omega * t;
+      rho = rho_new;
+      rn = static_cast<double>(r.norm());
+      st.record(rn);
+      if (!std::isfinite(rn)) {
+        reason = "non-finite residual";
+        break;
+      }
+      if (rn <= st.target || omega == S(0.0)) break;
+    }
+    if (reason.empty()) {  // restart from the true residual; give up if a cycle gained nothing
+      rn = st.true_residual(r, tmp);
+      if (!(rn < cycle_start)) reason = "stagnation";
+    }
+  }
+  return st.finish(r, tmp, reason);
+}
+
+/// Right-preconditioned transpose-free QMR (Freund 1993), in the two-half-steps form; the
+/// QMR bound tau sqrt(m+1) is the stopping estimate, confirmed on the true residual.
+template <class S, class Op, class Pre>
+krylov_report tfqmr(const Op& a, const Pre& m_pre, const vec<S>& b, vec<S>& x, const krylov_options& opt = {}) {
+  internal::krylov_state<S, Op, Pre> st("TFQMR", a, m_pre, b, x, opt);
+  using real = real_of_t<S>;
+  const Eigen::Index n = b.size();
+  vec<S> r(n), tmp(n);
+  double rn = st.true_residual(r, tmp);
+  st.rep.initial_residual = rn / st.scale();
+  st.record(rn);
+  std::string reason;
+  vec<S> rhat(n), w(n), y1(n), y2(n), z(n), u1(n), u2(n), v(n), d(n);
+  while (reason.empty() && std::isfinite(rn) && rn > st.target && !st.out_of_iterations()) {
+    const double cycle_start = rn;
+    rhat = r;
+    w = r;
+    y1 = r;
+    st.pre(y1, z);
+    st.op(z, u1);
+    v = u1;
+    d.setZero();
+    real theta(0), tau = static_cast<real>(rn);
+    S eta(0.0);
+    S rho = rhat.dot(r);
+    bool done = false;
+    for (int k = 1; !st.out_of_iterations() && !done; ++k) {
+      const S sigma = rhat.dot(v);
+      if (sigma == S(0.0) || rho == S(0.0)) break;  // restart
+      const S alpha = rho / sigma;
+      for (int j = 1; j <= 2; ++j) {
+        if (j == 2) {  // (for j = 1, z = M^{-1} y1 is still there from forming u1)
+          y2 = y1 - alpha * v;
+          st.pre(y2, z);
+          st.op(z, u2);
+        }
+        w -= alpha * (j == 1 ? u1 : u2);
+        d = z + (S(theta * theta) * eta / alpha) * d;  // d lives in x space: M^{-1} of Freund's d
+        theta = static_cast<real>(w.norm()) / tau;
+        const real c = real(1) / std::sqrt(real(1) + theta * theta);
+        tau = tau * theta * c;
+        eta = S(c * c) * alpha;
+        x += eta * d;
+        const double est = static_cast<double>(tau) * std::sqrt(2.0 * k - 2 + j + 1);
+        if (!std::isfinite(est)) {
+          reason = "non-finite residual";
+          done = true;
+          break;
+        }
+        if (est <= st.target) {
+          done = true;
+          break;
+        }
+      }
+      ++st.rep.iterations;
+      st.record(static_cast<double>(tau) * std::sqrt(2.0 * k + 1));
+      if (done) break;
+      const S rho_new = rhat.dot(w);
+      const S beta = rho_new / rho;
+      rho = rho_new;
+      y1 = w + beta * y2;
+      st.pre(y1, z);
+      st.op(z, u1);
+      v = u1 + beta * (u2 + beta * v);
+    }
+    if (reason.empty()) {
+      rn = st.true_residual(r, tmp);
+      if (!(rn < cycle_start)) reason = "stagnation";
+    }
+  }
+  return st.finish(r, tmp, reason);
+}
+
+}  // namespace aerohopf

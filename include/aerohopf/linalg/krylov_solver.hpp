@@ -1,0 +1,106 @@
+#pragma once
+// BILU(k)-preconditioned Krylov solver behind the compute/solve interface of direct.hpp, so the
+// nonlinear and bifurcation layers can swap
+//     direct_solver<Eigen::SparseMatrix<double>> s;   ->   krylov_solver<Eigen::SparseMatrix<double>> s;
+//     s.compute(A);  x = s.solve(b);
+// without other change. WHY: the sparse LU of a 3D flow Jacobian (or of A - i omega I) fills
+// in far beyond memory; BILU(k) + GMRES keeps the storage within a few times the matrix.
+//
+// The matrix (Eigen sparse or dense, real or complex) is blocked with block size B (compile
+// time; Eigen::Dynamic = options.block_size at run time, default 1 = point ILU(k)); sizes that
+// are not a multiple of the block size are padded (block_sparse_matrix.hpp). The symbolic
+// BILU phase is redone only when the sparsity pattern changes, so a Newton loop pays it once.
+// A solve that does not reach the tolerance throws convergence_error (like direct_solver
+// throws on a singular matrix); last_report() gives the iteration history either way.
+#include <string>
+
+#include "block_ilu.hpp"
+#include "block_sparse_matrix.hpp"
+#include "krylov.hpp"
+
+namespace aerohopf {
+
+enum class krylov_method { gmres, gcr, tfqmr, bicgstab };
+
+struct krylov_solver_options {
+  krylov_method method = krylov_method::gmres;
+  Eigen::Index block_size = 1;  ///< used when B == Eigen::Dynamic
+  int fill_level = 1;           ///< k of BILU(k)
+  bool reorder_rcm = false;
+  krylov_options krylov{};      ///< tolerances, restart, max iterations
+};
+
+/// Runs the chosen method.
+template <class S, class Op, class Pre>
+krylov_report krylov_solve(krylov_method method, const Op& a, const Pre& m, const vec<S>& b, vec<S>& x,
+                           const krylov_options& opt) {
+  switch (method) {
+    case krylov_method::gcr: return gcr(a, m, b, x, opt);
+    case krylov_method::tfqmr: return tfqmr(a, m, b, x, opt);
+    case krylov_method::bicgstab: return bicgstab(a, m, b, x, opt);
+    default: return gmres(a, m, b, x, opt);
+  }
+}
+
+template <class Matrix, int B = Eigen::Dynamic>
+class krylov_solver {
+ public:
+  using scalar = typename Matrix::Scalar;
+  using block_matrix = block_sparse_matrix<scalar, B>;
+
+  explicit krylov_solver(krylov_solver_options options = {}, std::string context = "BILU-Krylov")
+      : opt_(std::move(options)), context_(std::move(context)) {
+    if (B != Eigen::Dynamic) opt_.block_size = B;
+    require(opt_.block_size > 0, context_, ": block size ", opt_.block_size, " <= 0");
+    block_ilu_options io;
+    io.fill_level = opt_.fill_level;
+    io.reorder_rcm = opt_.reorder_rcm;
+    io.context = context_ + " BILU(" + std::to_string(opt_.fill_level) + ")";
+    ilu_ = block_ilu<scalar, B>(io);
+    opt_.krylov.context = context_;
+  }
+
+  krylov_solver& compute(const Matrix& a) {
+    require(a.rows() == a.cols(), context_, ": matrix is ", a.rows(), "x", a.cols(), ", not square");
+    if constexpr (is_sparse_matrix_v<Matrix>) a_ = block_matrix::from_sparse(a, opt_.block_size);
+    else a_ = block_matrix::from_sparse(a.sparseView(), opt_.block_size);
+    try {
+      ilu_.compute(a_);
+    } catch (const input_error& e) {  // non-finite matrix entries: same exception as direct_solver
+      throw singular_matrix_error(e.what());
+    }
+    n_ = a.rows();
+    return *this;
+  }
+
+  /// Solves A x = b column by column (zero initial guess); throws convergence_error on failure.
+  template <class Rhs>
+  auto solve(const Eigen::MatrixBase<Rhs>& b) const {
+    require(b.rows() == n_, context_, ": right-hand side has ", b.rows(), " rows, matrix ", n_);
+    Eigen::Matrix<scalar, Eigen::Dynamic, Rhs::ColsAtCompileTime> x(n_, b.cols());
+    krylov_options o = opt_.krylov;
+    o.throw_on_failure = true;
+    for (Eigen::Index c = 0; c < b.cols(); ++c) {
+      const vec<scalar> bp = pad_vector(vec<scalar>(b.col(c).template cast<scalar>()), a_.rows());
+      vec<scalar> xp = vec<scalar>::Zero(a_.rows());
+      report_ = krylov_solve(opt_.method, a_, ilu_, bp, xp, o);
+      x.col(c) = xp.head(n_);
+    }
+    return x;
+  }
+
+  Eigen::Index rows() const { return n_; }
+  const krylov_report& last_report() const { return report_; }
+  const block_matrix& blocked_matrix() const { return a_; }
+  const block_ilu<scalar, B>& preconditioner() const { return ilu_; }
+
+ private:
+  krylov_solver_options opt_;
+  std::string context_;
+  block_matrix a_{B == Eigen::Dynamic ? opt_.block_size : Eigen::Index(B)};
+  block_ilu<scalar, B> ilu_;
+  Eigen::Index n_ = 0;
+  mutable krylov_report report_;
+};
+
+}  // namespace aerohopf
