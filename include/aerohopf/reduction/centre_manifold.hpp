@@ -189,7 +189,7 @@ centre_manifold_coefficients reduce_to_centre_manifold(const S& s, const hopf_po
   r.q_A_mu_p = inner(r.q, a_mu_p);
   r.q_A_mu_pbar = inner(r.q, a_mu_p.conjugate());
   r.q_A_mu_k20 = inner(r.q, internal::apply_real(a_mu, r.k20));
-  r.q_A_mu_k11 = inner(r.q, (a_mu * r.k11).cast<C>().eval());
+  r.q_A_mu_k11 = inner(r.q, vec<double>(a_mu * r.k11).cast<C>().eval());
   r.q_A_mu_k02 = inner(r.q, internal::apply_real(a_mu, cvec(r.k20.conjugate())));
 
   r.lambda_mu = r.q_A_mu_p;
