@@ -92,7 +92,7 @@ struct continuation_result {
 };
 
 namespace internal {
-template <system S>
+template <dynamical_system S>
 void evaluate_spectrum(const S& sys, branch_point& bp, const continuation_options& opt) {
   std::vector<std::complex<double>> ev;
   const auto a = sys.jacobian(bp.w, bp.mu);
@@ -115,7 +115,7 @@ void evaluate_spectrum(const S& sys, branch_point& bp, const continuation_option
 }  // namespace internal
 
 /// Natural-parameter continuation: mu_k = mu0 + k dmu (opt.ds), k = 1..opt.max_steps.
-template <system S>
+template <dynamical_system S>
 continuation_result natural_continuation(const S& sys, const vec<double>& w0, double mu0,
                                          const continuation_options& opt = {}) {
   check_state(sys, w0, mu0, "natural_continuation");
@@ -151,7 +151,7 @@ continuation_result natural_continuation(const S& sys, const vec<double>& w0, do
 
 /// Pseudo-arclength continuation from an equilibrium (w0, mu0) in the direction of increasing
 /// mu (direction = +1) or decreasing mu (-1).
-template <system S>
+template <dynamical_system S>
 continuation_result pseudo_arclength_continuation(const S& sys, const vec<double>& w0, double mu0,
                                                   const continuation_options& opt = {}, int direction = +1) {
   using M = jacobian_t<S>;

@@ -72,7 +72,7 @@ inline vec<double> hopf_normalise(vec<std::complex<double>>& p) {
 }
 
 /// Start point for the Hopf Newton iteration: inverse power at (w, mu) with shift i omega_guess.
-template <system S>
+template <dynamical_system S>
 hopf_point hopf_start(const S& sys, const vec<double>& w, double mu, double omega_guess,
                       const inverse_power_options& ipo = {}) {
   check_state(sys, w, mu, "hopf_start");
@@ -86,7 +86,7 @@ hopf_point hopf_start(const S& sys, const vec<double>& w, double mu, double omeg
 }
 
 /// Newton on the augmented system from a guess (w, mu, omega, p of any normalisation).
-template <system S>
+template <dynamical_system S>
 hopf_result solve_hopf(const S& sys, const hopf_point& guess, const hopf_options& opt = {}) {
   using M = jacobian_t<S>;
   const Eigen::Index n = sys.size();

@@ -20,7 +20,7 @@ struct root_locus_point {
 };
 
 /// equilibrium(mu) returns w0(mu); shift0 starts the first inverse power (e.g. i omega_structural).
-template <system S>
+template <dynamical_system S>
 std::vector<root_locus_point> root_locus(const S& sys, const std::function<vec<double>(double)>& equilibrium,
                                          const std::vector<double>& mus, std::complex<double> shift0,
                                          const inverse_power_options& ipo = {}) {

@@ -152,7 +152,7 @@ newton_result newton_iterate(ResidualFn&& residual, StepFn&& solve_step, vec<dou
 }
 
 /// Newton with the exact Jacobian of the system at fixed mu.
-template <system S>
+template <dynamical_system S>
 newton_result newton(const S& s, const vec<double>& w0, double mu, const newton_options& opt = {}) {
   check_state(s, w0, mu, "newton");
   direct_solver<jacobian_t<S>> lu("newton: Jacobian");
@@ -165,7 +165,7 @@ newton_result newton(const S& s, const vec<double>& w0, double mu, const newton_
 }
 
 /// Newton chord: the Jacobian at w0 is factored once.
-template <system S>
+template <dynamical_system S>
 newton_result newton_chord(const S& s, const vec<double>& w0, double mu, const newton_options& opt = {}) {
   check_state(s, w0, mu, "newton_chord");
   direct_solver<jacobian_t<S>> lu("newton_chord: Jacobian");
@@ -183,7 +183,7 @@ struct pseudo_transient_options {
 
 /// Pseudo-transient (relaxed) Newton: (I/dt - A) dw = f with the left-hand-side Jacobian (the
 /// approximate one if the system provides it) and switched evolution relaxation of dt.
-template <system S>
+template <dynamical_system S>
 newton_result pseudo_transient_newton(const S& s, const vec<double>& w0, double mu, const newton_options& opt = {},
                                       const pseudo_transient_options& pto = {}) {
   check_state(s, w0, mu, "pseudo_transient_newton");
@@ -203,7 +203,7 @@ newton_result pseudo_transient_newton(const S& s, const vec<double>& w0, double 
 }
 
 /// Broyden's good method on a dense approximation started from the left-hand-side Jacobian at w0.
-template <system S>
+template <dynamical_system S>
 newton_result broyden(const S& s, const vec<double>& w0, double mu, const newton_options& opt = {}) {
   check_state(s, w0, mu, "broyden");
   Eigen::MatrixXd a = Eigen::MatrixXd(lhs_jacobian(s, w0, mu));

@@ -37,12 +37,17 @@
 namespace aerohopf {
 
 template <class S>
-concept system = requires(const S& s, const vec<double>& w, double mu) {
+concept dynamical_system = requires(const S& s, const vec<double>& w, double mu) {
   typename S::jacobian_type;
   { s.size() } -> std::convertible_to<Eigen::Index>;
   { s.residual(w, mu) } -> std::convertible_to<vec<double>>;
   { s.jacobian(w, mu) } -> std::convertible_to<typename S::jacobian_type>;
 };
+
+/// Same as dynamical_system. Prefer the longer name in user code: under `using namespace
+/// aerohopf;` the short one collides with std::system from <cstdlib>.
+template <class S>
+concept system = dynamical_system<S>;
 
 /// A system whose residual can be evaluated in scalar T (dd_real, qd_real, taylor<...>).
 template <class S, class T>
