@@ -261,6 +261,12 @@ TEST(CentreManifold, ReconstructionMatchesFullTimeMarchingOfNormalForm) {
     const auto [amp, mean] = model.component_amplitude(j, dmu);
     EXPECT_NEAR(amp, 0.5 * (hi[j] - lo[j]), 2e-6) << "component " << j;
     EXPECT_NEAR(mean, 0.5 * (hi[j] + lo[j]), 2e-6) << "component " << j;
+    // The integrated reduced model measured the same way.
+    const simulated_lco sim = model.simulate_lco(j, dmu, C(0.01, 0.0), 700.0, 0.005, 4 * 2 * std::numbers::pi);
+    EXPECT_NEAR(sim.amplitude, 0.5 * (hi[j] - lo[j]), 2e-6) << "component " << j;
+    EXPECT_NEAR(sim.frequency, 1.0, 1e-4);
+    EXPECT_GE(sim.periods, 3);
+    EXPECT_NEAR(sim.z_max, std::sqrt(dmu), 1e-6);
   }
 }
 

@@ -163,6 +163,21 @@ TEST(DerivativeProducts, PolarisationAndComplexCombinations) {
   EXPECT_GT(dm.third_evaluations(), 0);
 }
 
+TEST(DerivativeProducts, DirectionsOfAnyScaleReachTheProviderAsUnitVectors) {
+  // k11 or w0_mu can be O(1e3) near a fold: the step h must not be multiplied by their size.
+  const exp_system sys;
+  const vec<double> w0 = 0.3 * direction(5, 0.7);
+  const vec<double> big = 1e3 * direction(5, 1.9), small = 1e-4 * direction(5, -0.4);
+  const derivative_products exact(sys, w0, 0.37, taylor_products<>{});
+  const derivative_products fd(sys, w0, 0.37, fd_products<qd_real>{1e-9});
+  EXPECT_LT(rel_err(fd.B(big, small), exact.B(big, small)), 1e-12);
+  EXPECT_LT(rel_err(fd.C_vvu(big, small), exact.C_vvu(big, small)), 1e-12);
+  EXPECT_LT(rel_err(fd.C(big), exact.C(big)), 1e-12);
+  // Bilinearity survives the scaling.
+  EXPECT_LT(rel_err(exact.B(big, small), (1e-1 * exact.B(direction(5, 1.9), direction(5, -0.4))).eval()), 1e-14);
+  EXPECT_EQ(exact.B(big, vec<double>::Zero(5).eval()).norm(), 0.0);
+}
+
 TEST(DerivativeProducts, RejectsBadInput) {
   const exp_system sys;
   const vec<double> w0 = vec<double>::Zero(5);

@@ -31,6 +31,7 @@
 // moving_equilibrium). Both coincide when f_mu = 0 (e.g. the Hopf normal form).
 #include <Eigen/Core>
 
+#include <algorithm>
 #include <cmath>
 #include <complex>
 #include <numbers>
@@ -228,6 +229,15 @@ struct reduced_history {
   std::vector<std::complex<double>> z;
 };
 
+/// One state component on the cycle of the integrated reduced model (simulate_lco).
+struct simulated_lco {
+  double amplitude = 0;  ///< half peak-to-peak of the reconstructed component over the window
+  double mean = 0;       ///< mid value (max + min) / 2
+  double frequency = 0;  ///< from upward crossings of the mid value (0 if fewer than two)
+  double z_min = 0, z_max = 0;  ///< range of |z| over the window
+  int periods = 0;       ///< number of full periods in the window
+};
+
 /// The parameterised reduced 2-DOF model dz/dt = F(z, mu - mu*) of spec 03.
 class centre_manifold_model {
  public:
@@ -317,6 +327,44 @@ class centre_manifold_model {
       hi = k ? std::max(hi, wj) : wj;
     }
     return {0.5 * (hi - lo), 0.5 * (hi + lo)};
+  }
+
+  /// Integrates the reduced ODE (all terms, including the forcing of the spec dependence) from
+  /// z0 to t_end and measures state component j, reconstructed on the manifold, over the last
+  /// `window` time units: this is the model's LCO prediction when the closed form of lco() is
+  /// not adequate (f_mu != 0 makes the orbit eccentric about a shifted centre).
+  simulated_lco simulate_lco(Eigen::Index j, double dmu, complex z0, double t_end, double dt, double window) const {
+    require(j >= 0 && j < c_.w0.size(), "centre_manifold_model::simulate_lco: component ", j, " out of range [0, ",
+            c_.w0.size(), ")");
+    require(window > 0 && window <= t_end, "centre_manifold_model::simulate_lco: window ", window,
+            " must be in (0, t_end = ", t_end, "]");
+    const reduced_history h = integrate(z0, dmu, t_end, dt);
+    std::vector<double> t, x;
+    simulated_lco r;
+    r.z_min = 1e300;
+    for (size_t k = 0; k < h.t.size(); ++k) {
+      if (h.t[k] < t_end - window) continue;
+      t.push_back(h.t[k]);
+      x.push_back(reconstruct(h.z[k], dmu)[j]);
+      r.z_min = std::min(r.z_min, std::abs(h.z[k]));
+      r.z_max = std::max(r.z_max, std::abs(h.z[k]));
+    }
+    const auto [lo, hi] = std::minmax_element(x.begin(), x.end());
+    r.amplitude = 0.5 * (*hi - *lo);
+    r.mean = 0.5 * (*hi + *lo);
+    double first = -1, last = -1;
+    int crossings = 0;
+    for (size_t k = 1; k < x.size(); ++k) {
+      if (x[k - 1] < r.mean && x[k] >= r.mean) {
+        const double tc = t[k - 1] + (t[k] - t[k - 1]) * (r.mean - x[k - 1]) / (x[k] - x[k - 1]);
+        if (crossings == 0) first = tc;
+        last = tc;
+        ++crossings;
+      }
+    }
+    r.periods = std::max(0, crossings - 1);
+    if (r.periods > 0) r.frequency = 2 * std::numbers::pi * r.periods / (last - first);
+    return r;
   }
 
   /// Classical RK4 for the reduced ODE from z0 to t_end with a fixed step close to dt (rounded

@@ -17,7 +17,8 @@
 //    vec<double> third (const S&, const vec<double>& w0, double mu, const vec<double>& v) const;
 //
 // derivative_products<S, Provider> binds system, equilibrium and provider and builds every
-// product the centre-manifold coefficients need from those two by polarisation (spec 03):
+// product the centre-manifold coefficients need from those two by polarisation (spec 03),
+// handing the provider unit-norm directions only (so h is a step along a unit vector):
 //    B(v, u)    = 1/4 [B(v+u, v+u) - B(v-u, v-u)]
 //    C(v, v, u) = 1/6 [C(v+u)^3 - C(v-u)^3 - 2 C(u, u, u)]
 // and, for complex p = a + i b, k = c + i d (B, C are real multilinear forms),
@@ -177,20 +178,33 @@ class derivative_products {
   int third_evaluations() const { return n_third_; }
 
   // ---- real directions ----
+  // Every direction handed to the provider is scaled to unit 2-norm first (B(v, v) =
+  // |v|^2 B(v^, v^), ...), so a finite-difference step h always means the same thing, however
+  // large or small the vectors of the reduction are (k11, w0_mu can be O(1e3) near a fold).
   vec<double> B(const vec<double>& v) const {
+    const double nv = v.norm();
+    if (nv == 0) return vec<double>::Zero(v.size());
     ++n_second_;
-    return provider_.second(s_, w0_, mu_, v);
+    return (nv * nv) * provider_.second(s_, w0_, mu_, vec<double>(v / nv));
   }
   vec<double> B(const vec<double>& v, const vec<double>& u) const {
-    return 0.25 * (B((v + u).eval()) - B((v - u).eval()));
+    const double nv = v.norm(), nu = u.norm();
+    if (nv == 0 || nu == 0) return vec<double>::Zero(v.size());
+    const vec<double> vh = v / nv, uh = u / nu;
+    return (0.25 * nv * nu) * (B(vec<double>(vh + uh)) - B(vec<double>(vh - uh)));
   }
   vec<double> C(const vec<double>& v) const {
+    const double nv = v.norm();
+    if (nv == 0) return vec<double>::Zero(v.size());
     ++n_third_;
-    return provider_.third(s_, w0_, mu_, v);
+    return (nv * nv * nv) * provider_.third(s_, w0_, mu_, vec<double>(v / nv));
   }
   /// C(v, v, u).
   vec<double> C_vvu(const vec<double>& v, const vec<double>& u) const {
-    return (C((v + u).eval()) - C((v - u).eval()) - 2.0 * C(u)) / 6.0;
+    const double nv = v.norm(), nu = u.norm();
+    if (nv == 0 || nu == 0) return vec<double>::Zero(v.size());
+    const vec<double> vh = v / nv, uh = u / nu;
+    return (nv * nv * nu / 6.0) * (C(vec<double>(vh + uh)) - C(vec<double>(vh - uh)) - 2.0 * C(uh));
   }
 
   // ---- complex directions (B, C are real forms extended bilinearly, no conjugation) ----
