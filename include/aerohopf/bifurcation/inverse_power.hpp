@@ -12,9 +12,11 @@
 //
 // Eigenvalue estimate: with C = A - sigma I and C y = x, the Rayleigh quotient of C on y is
 // <y, C y>/<y, y> = <y, x>/<y, y>, so lambda = sigma + <y, x>/<y, y>.
-// Convergence: ||A x - lambda x||_2 <= tolerance * max(1, |lambda|) with ||x||_2 = 1.
+// Convergence: ||A x - lambda x||_2 <= tolerance * max(1, |lambda|, ||A||_inf) with ||x||_2 = 1
+// (the residual cannot drop below about eps ||A||: stiff discretisations have a large ||A||).
 #include <Eigen/Core>
 
+#include <algorithm>
 #include <cmath>
 #include <complex>
 #include <iostream>
@@ -25,7 +27,7 @@
 namespace aerohopf {
 
 struct inverse_power_options {
-  double tolerance = 1e-12;  ///< on ||A x - lambda x||_2 / max(1, |lambda|), ||x||_2 = 1
+  double tolerance = 1e-12;  ///< on ||A x - lambda x||_2 / max(1, |lambda|, ||A||_inf), ||x||_2 = 1
   int max_iterations = 100;
   bool verbose = false;
   std::ostream* log = &std::cout;
@@ -79,6 +81,17 @@ eigen_pair inverse_power_impl(const Matrix& a, std::complex<double> shift, const
     }
   }
   const auto ac = a.template cast<C>();
+  double a_norm = 0;  // ||A||_inf, the scale of the attainable residual
+  {
+    vec<double> row_sums = vec<double>::Zero(a.rows());
+    if constexpr (is_sparse_matrix_v<Matrix>) {
+      for (int k = 0; k < a.outerSize(); ++k)
+        for (typename Matrix::InnerIterator it(a, k); it; ++it) row_sums[it.row()] += std::abs(it.value());
+    } else {
+      row_sums = a.cwiseAbs().rowwise().sum();
+    }
+    a_norm = row_sums.size() ? row_sums.maxCoeff() : 0.0;
+  }
 
   vec<C> x = start ? start->normalized() : default_start(a.rows());
   if (!x.allFinite() || x.norm() == 0) x = default_start(a.rows());
@@ -94,7 +107,7 @@ eigen_pair inverse_power_impl(const Matrix& a, std::complex<double> shift, const
     r.iterations = t;
     if (opt.verbose && opt.log)
       *opt.log << who << " it " << t << "  lambda " << r.lambda << "  residual " << r.residual << "\n";
-    if (r.residual <= opt.tolerance * std::max(1.0, std::abs(r.lambda))) {
+    if (r.residual <= opt.tolerance * std::max({1.0, std::abs(r.lambda), a_norm})) {
       normalise_phase(x);
       r.vector = x;
       return r;
