@@ -23,9 +23,10 @@
 // Equilibrium w = 0 for every mu; Hopf point mu* = 0, omega = 1; eigenvalues mu +- i, -d_k.
 #include <Eigen/Dense>
 
+#include <algorithm>
 #include <cmath>
 #include <complex>
-#include <random>
+#include <cstdint>
 
 #include "../bifurcation/hopf_point.hpp"
 #include "../error.hpp"
@@ -43,11 +44,20 @@ class hopf_normal_form {
     require(std::isfinite(s) && s != 0, "hopf_normal_form: s must be finite and non-zero (got ", s, ")");
     require(n_extra >= 0, "hopf_normal_form: n_extra must be >= 0 (got ", n_extra, ")");
     const int n = 2 + m_;
-    std::mt19937 gen(seed);
-    std::uniform_real_distribution<double> unit(-1.0, 1.0);
+    // splitmix64: the same numbers on every platform (std:: distributions are not portable).
+    std::uint64_t state = 0x9e3779b97f4a7c15ULL * (seed + 1ULL);
+    auto unit = [&state]() {
+      std::uint64_t z = (state += 0x9e3779b97f4a7c15ULL);
+      z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
+      z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
+      z ^= z >> 31;
+      return 2.0 * (static_cast<double>(z >> 11) * 0x1.0p-53) - 1.0;  // uniform in [-1, 1)
+    };
+    // I + E with ||E||_2 about 0.8 at most (entries scaled with 1/sqrt(n)): cond(T) stays small.
+    const double skew = std::min(0.35, 0.8 / std::sqrt(double(n)));
     t_ = Eigen::MatrixXd::Identity(n, n);
     for (int j = 0; j < n; ++j)
-      for (int i = 0; i < n; ++i) t_(i, j) += 0.35 * unit(gen);
+      for (int i = 0; i < n; ++i) t_(i, j) += skew * unit();
     t_.col(0) *= std::sqrt(2.0) / t_.col(0).norm();
     t_.col(1) *= std::sqrt(2.0) / t_.col(1).norm();
     t_inv_ = t_.inverse();
@@ -56,10 +66,10 @@ class hopf_normal_form {
     b_.resize(m_);
     c_.resize(m_);
     for (int k = 0; k < m_; ++k) {
-      d_[k] = 2.0 + unit(gen);  // in [1, 3]: well separated from the centre pair
-      a_[k] = unit(gen);
-      b_[k] = unit(gen);
-      c_[k] = unit(gen);
+      d_[k] = 2.0 + unit();  // in [1, 3]: well separated from the centre pair
+      a_[k] = unit();
+      b_[k] = unit();
+      c_[k] = unit();
     }
   }
 

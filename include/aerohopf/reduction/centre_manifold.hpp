@@ -312,21 +312,38 @@ class centre_manifold_model {
     return w;
   }
 
-  /// Amplitude (half peak-to-peak) and mean of state component j over the predicted cycle,
-  /// sampled at n_samples phases of z = |z| e^{i theta}; zero amplitude if no cycle.
-  std::pair<double, double> component_amplitude(Eigen::Index j, double dmu, int n_samples = 256) const {
+  /// Amplitude (half peak-to-peak) and mean of state component j over the predicted cycle
+  /// z = |z| e^{i theta}. On the cycle the component is the trigonometric polynomial
+  /// w0_j (+ w0_mu,j mu) + k11_j |z|^2 + Re(2 p_j |z| e^{i theta}) + Re(k20_j |z|^2 e^{2 i theta}),
+  /// sampled at n_samples phases with parabolic refinement of the extremes (scalar work only).
+  /// Zero amplitude if no cycle exists at this mu.
+  std::pair<double, double> component_amplitude(Eigen::Index j, double dmu, int n_samples = 1024) const {
     require(j >= 0 && j < c_.w0.size(), "centre_manifold_model::component_amplitude: component ", j,
             " out of range [0, ", c_.w0.size(), ")");
-    require(n_samples >= 4, "centre_manifold_model::component_amplitude: n_samples must be >= 4");
-    const lco_prediction l = lco(dmu);
-    double lo = 0, hi = 0;
-    for (int k = 0; k < n_samples; ++k) {
-      const double theta = 2 * std::numbers::pi * k / n_samples;
-      const double wj = reconstruct(std::polar(l.amplitude, theta), dmu)[j];
-      lo = k ? std::min(lo, wj) : wj;
-      hi = k ? std::max(hi, wj) : wj;
+    require(n_samples >= 8, "centre_manifold_model::component_amplitude: n_samples must be >= 8");
+    const double r = lco(dmu).amplitude;
+    const double base = c_.w0[j] + (moving() ? dmu * c_.w0_mu[j] : 0.0) + r * r * c_.k11[j];
+    const complex a1 = 2.0 * r * c_.p[j], a2 = r * r * c_.k20[j];
+    auto value = [&](double theta) {
+      return base + (a1 * std::polar(1.0, theta)).real() + (a2 * std::polar(1.0, 2 * theta)).real();
+    };
+    const double dtheta = 2 * std::numbers::pi / n_samples;
+    int kmin = 0, kmax = 0;
+    double vmin = value(0), vmax = vmin;
+    for (int k = 1; k < n_samples; ++k) {
+      const double v = value(k * dtheta);
+      if (v < vmin) vmin = v, kmin = k;
+      if (v > vmax) vmax = v, kmax = k;
     }
-    return {0.5 * (hi - lo), 0.5 * (hi + lo)};
+    // Vertex of the parabola through the neighbours of a sampled extreme.
+    auto refine = [&](int k) {
+      const double fm = value((k - 1) * dtheta), f0 = value(k * dtheta), fp = value((k + 1) * dtheta);
+      const double den = fm - 2 * f0 + fp;
+      return den == 0 ? f0 : f0 - 0.125 * (fp - fm) * (fp - fm) / den;
+    };
+    vmin = std::min(vmin, refine(kmin));
+    vmax = std::max(vmax, refine(kmax));
+    return {0.5 * (vmax - vmin), 0.5 * (vmax + vmin)};
   }
 
   /// Integrates the reduced ODE (all terms, including the forcing of the spec dependence) from

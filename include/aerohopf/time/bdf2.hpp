@@ -15,7 +15,8 @@
 // which is how CFD codes drive the unsteady residual to zero (robust far from the solution,
 // linear instead of quadratic inner convergence). pseudo_dt = 0 is plain Newton.
 //
-// Inner convergence: ||dw||_inf <= inner_tolerance * (1 + ||w||_inf). If it is not reached in
+// Inner convergence: ||dw||_inf <= inner_tolerance * (1 + ||w||_inf) (in dual time also
+// ||R||_inf / c below the same bound). If it is not reached in
 // max_inner_iterations, convergence_error names the time step, time, iterations and residual.
 #include <Eigen/Core>
 
@@ -87,7 +88,10 @@ vec<double> integrate_bdf2(const S& s, double mu, vec<double> w0, double t0, dou
       const vec<double> dx = solver.solve(vec<double>(-r));
       x += dx;
       dnorm = dx.template lpNorm<Eigen::Infinity>();
-      if (dnorm <= opt.inner_tolerance * (1.0 + x.template lpNorm<Eigen::Infinity>())) {
+      const double scale = opt.inner_tolerance * (1.0 + x.template lpNorm<Eigen::Infinity>());
+      // In dual time a small pseudo step makes dw small long before R is: also require the
+      // plain implicit correction R / c to be small.
+      if (dnorm <= scale && (opt.pseudo_dt == 0 || rnorm / c <= scale)) {
         converged = true;
         break;
       }
