@@ -277,18 +277,36 @@ class block_ilu {
     else
       for (int i = 0; i < n_; ++i)
         Eigen::Map<segment_type>(w + index(i) * b, b) = r.template segment<B>(index(perm_[i]) * b, b);
-    segment_type acc(b);
-    for (int i = 0; i < n_; ++i) {  // forward: L y = r (unit block diagonal)
-      acc = Eigen::Map<segment_type>(w + index(i) * b, b);
-      for (int q = row_ptr_[i]; q < diag_[i]; ++q)
-        acc.noalias() -= cblk(q) * Eigen::Map<const segment_type>(w + index(col_[q]) * b, b);
-      Eigen::Map<segment_type>(w + index(i) * b, b) = acc;
-    }
-    for (int i = n_ - 1; i >= 0; --i) {  // backward: U x = y, diagonal stored inverted
-      acc = Eigen::Map<segment_type>(w + index(i) * b, b);
-      for (int q = diag_[i] + 1; q < row_ptr_[i + 1]; ++q)
-        acc.noalias() -= cblk(q) * Eigen::Map<const segment_type>(w + index(col_[q]) * b, b);
-      Eigen::Map<segment_type>(w + index(i) * b, b).noalias() = cblk(diag_[i]) * acc;
+    if constexpr (internal::has_fast_block_kernel_v<Scalar, B>) {
+      const Scalar* v = val_.data();
+      for (int i = 0; i < n_; ++i) {  // forward: L y = r (unit block diagonal)
+        Scalar* wi = w + index(i) * B;
+        for (int q = row_ptr_[i]; q < diag_[i]; ++q)
+          internal::block_gemv<-1, B>(v + index(q) * B * B, w + index(col_[q]) * B, wi);
+      }
+      for (int i = n_ - 1; i >= 0; --i) {  // backward: U x = y, diagonal stored inverted
+        Scalar acc[B];
+        Scalar* wi = w + index(i) * B;
+        for (int r = 0; r < B; ++r) acc[r] = wi[r];
+        for (int q = diag_[i] + 1; q < row_ptr_[i + 1]; ++q)
+          internal::block_gemv<-1, B>(v + index(q) * B * B, w + index(col_[q]) * B, acc);
+        for (int r = 0; r < B; ++r) wi[r] = Scalar(0.0);
+        internal::block_gemv<1, B>(v + index(diag_[i]) * B * B, acc, wi);
+      }
+    } else {
+      segment_type acc(b);
+      for (int i = 0; i < n_; ++i) {  // forward: L y = r (unit block diagonal)
+        acc = Eigen::Map<segment_type>(w + index(i) * b, b);
+        for (int q = row_ptr_[i]; q < diag_[i]; ++q)
+          acc.noalias() -= cblk(q) * Eigen::Map<const segment_type>(w + index(col_[q]) * b, b);
+        Eigen::Map<segment_type>(w + index(i) * b, b) = acc;
+      }
+      for (int i = n_ - 1; i >= 0; --i) {  // backward: U x = y, diagonal stored inverted
+        acc = Eigen::Map<segment_type>(w + index(i) * b, b);
+        for (int q = diag_[i] + 1; q < row_ptr_[i + 1]; ++q)
+          acc.noalias() -= cblk(q) * Eigen::Map<const segment_type>(w + index(col_[q]) * b, b);
+        Eigen::Map<segment_type>(w + index(i) * b, b).noalias() = cblk(diag_[i]) * acc;
+      }
     }
     if (!perm_.empty())
       for (int i = 0; i < n_; ++i)

@@ -45,6 +45,7 @@
 
 #include "../error.hpp"
 #include "../scalar/complex.hpp"
+#include "block_kernels.hpp"
 #include "direct.hpp"
 #include "operator.hpp"
 
@@ -346,14 +347,27 @@ class block_sparse_matrix {
     Scalar* yv = y.data();
     const Scalar* v = val_.data();
     const storage_index* cols = col_.data();
-    for (index i = 0; i < nbr_; ++i) {
-      segment_type acc = segment_type::Zero(b);
-      for (storage_index p = row_ptr_[i]; p < row_ptr_[i + 1]; ++p)
-        acc.noalias() += const_block_map(v + index(p) * b * b, b, b) *
-                         Eigen::Map<const segment_type>(xv + index(cols[p]) * b, b);
-      Eigen::Map<segment_type> yi(yv + i * b, b);
-      if constexpr (Accumulate) yi += alpha * acc;
-      else yi = acc;
+    if constexpr (internal::has_fast_block_kernel_v<Scalar, B>) {
+      for (index i = 0; i < nbr_; ++i) {
+        Scalar acc[B];
+        for (int r = 0; r < B; ++r) acc[r] = Scalar(0.0);
+        for (storage_index p = row_ptr_[i]; p < row_ptr_[i + 1]; ++p)
+          internal::block_gemv<1, B>(v + index(p) * B * B, xv + index(cols[p]) * B, acc);
+        for (int r = 0; r < B; ++r) {
+          if constexpr (Accumulate) yv[i * B + r] += alpha * acc[r];
+          else yv[i * B + r] = acc[r];
+        }
+      }
+    } else {
+      for (index i = 0; i < nbr_; ++i) {
+        segment_type acc = segment_type::Zero(b);
+        for (storage_index p = row_ptr_[i]; p < row_ptr_[i + 1]; ++p)
+          acc.noalias() += const_block_map(v + index(p) * b * b, b, b) *
+                           Eigen::Map<const segment_type>(xv + index(cols[p]) * b, b);
+        Eigen::Map<segment_type> yi(yv + i * b, b);
+        if constexpr (Accumulate) yi += alpha * acc;
+        else yi = acc;
+      }
     }
   }
 
