@@ -56,9 +56,15 @@ std::array<double, Dim> face_centre(const grid_block<S, Dim>& g, int d, const in
 
 struct euler_options {
   int order = 2;                   // 1: piecewise-constant states, 2: MUSCL / van Albada
-  double limiter_eps = 1e-6;       // eps of the van Albada limiter
+  double limiter_eps = 1e-3;       // eps of the van Albada limiter (variables are O(1))
   std::array<double, 3> moment_centre{0.25, 0.0, 0.0};  // reference point of the moment
   std::string force_tag;           // walls whose forces are integrated ("" = all walls)
+  /// Slip-wall flux. extrapolated: pure pressure flux (0, p_w S, p_w q) with the wall pressure
+  /// extrapolated linearly from the two adjacent cells, p_w = (3 p_0 - p_1)/2 (zero mass flux
+  /// exactly; keeps the normal pressure gradient that wall curvature requires, which the
+  /// mirror image cannot: far less spurious entropy at a leading edge resolved by only 0.01 c
+  /// cells). riemann: Osher flux between the cell and its mirror image.
+  enum class wall_flux { extrapolated, riemann } wall = wall_flux::extrapolated;
 };
 
 /// Force and moment coefficients (reference length 1, reference area 1 (2D: per unit span),
@@ -178,7 +184,7 @@ class euler_model {
           for (int e = 0; e < Dim; ++e) p[e] += halo_width;
           const std::size_t c0 = linear_index<Dim>(p, pd);  // cell on the + side of the face
           const std::size_t cm = c0 - stride;               // cell on the - side
-          const auto flux = face_flux<S>(prim[b], cm, stride, mb.normal[d][k], mb.speed[d][k]);
+          const auto flux = face_flux<S>(prim[b], cm, stride, mb.normal[d][k], mb.speed[d][k], wall_side(b, d, k));
           const S& q = mb.speed[d][k];
           if (f > 0) {
             const std::size_t ic = interior_index(b, cm);
@@ -198,16 +204,35 @@ class euler_model {
   /// Flux through the face between padded cells cm and cm + stride of one block.
   template <class S>
   state<S, Dim> face_flux(const std::vector<primitive<S, Dim>>& prim, std::size_t cm, std::size_t stride,
-                          const std::array<S, Dim>& area, const S& q, osher_star<S>* star = nullptr) const {
+                          const std::array<S, Dim>& area, const S& q, int wall = 0) const {
     const std::size_t c0 = cm + stride;
-    return face_flux4<S>(prim[cm - stride], prim[cm], prim[c0], prim[c0 + stride], area, q, star);
+    return face_flux4<S>(prim[cm - stride], prim[cm], prim[c0], prim[c0 + stride], area, q, wall);
+  }
+
+  /// 0 for a face that is not a slip wall with the extrapolated wall flux; otherwise +1 (-1) if
+  /// the wall lies on the + (-) side of the face, i.e. the fluid is on the - (+) side.
+  int wall_side(int b, int d, std::size_t k) const { return wall_flag_.empty() ? 0 : wall_flag_[b][d][k]; }
+
+  /// Wall pressure extrapolated from the two fluid cells next to the wall.
+  template <class S>
+  static S wall_pressure(const primitive<S, Dim>& first, const primitive<S, Dim>& second) {
+    return S(1.5) * first.p - S(0.5) * second.p;
   }
 
   /// Flux through a face from the 4 cells along the grid line (two on each side).
   template <class S>
   state<S, Dim> face_flux4(const primitive<S, Dim>& qmm, const primitive<S, Dim>& qm, const primitive<S, Dim>& qp,
                            const primitive<S, Dim>& qpp, const std::array<S, Dim>& area, const S& q,
-                           osher_star<S>* star = nullptr) const {
+                           int wall = 0, osher_star<S>* star = nullptr) const {
+    if (wall != 0) {
+      const S pw = wall > 0 ? wall_pressure<S>(qm, qmm) : wall_pressure<S>(qp, qpp);
+      if (star) *star = {pw, S(0.0)};
+      state<S, Dim> f;
+      f[0] = S(0.0);
+      for (int d = 0; d < Dim; ++d) f[1 + d] = pw * area[d];
+      f[Dim + 1] = pw * q;
+      return f;
+    }
     if (opt_.order == 1) return osher_flux<S, Dim>(qm, qp, area, q, star);
     const auto ql = muscl_left<S, Dim>(qmm, qm, qp, opt_.limiter_eps);
     const auto qr = muscl_right<S, Dim>(qm, qp, qpp, opt_.limiter_eps);
@@ -282,7 +307,7 @@ class euler_model {
       osher_star<double> star{};
       (void)face_flux4<double>(prim(cm - stride), prim(cm), prim(cm + stride), prim(cm + 2 * stride),
                                metrics_.blocks[b].normal[h.dir][h.face], metrics_.blocks[b].speed[h.dir][h.face],
-                               &star);
+                               wall_side(b, h.dir, h.face), &star);
       wall_face f;
       f.block = b;
       f.pressure = star.pressure;
@@ -290,7 +315,7 @@ class euler_model {
       const auto& s = metrics_.blocks[b].normal[h.dir][h.face];
       for (int d = 0; d < Dim; ++d) f.area_out[d] = h.sign * s[d];
       auto p = unravel<Dim>(h.face, metrics_.blocks[b].face_dims(h.dir));
-      f.centre = internal::face_centre(grid_.points.blocks[b], h.dir, p);
+      f.centre = internal::face_centre<double, Dim>(grid_.points.blocks[b], h.dir, p);
       out.push_back(f);
     }
     return out;
@@ -469,6 +494,13 @@ class euler_model {
         fc[f / 2] = 1;
         coverage[b][f].assign(product<Dim>(fc), 0);
       }
+    wall_flag_.assign(nb, {});
+    for (int b = 0; b < nb; ++b)
+      for (int d = 0; d < Dim; ++d) {
+        auto fd = cells[b];
+        fd[d] += 1;
+        wall_flag_[b][d].assign(product<Dim>(fd), 0);
+      }
     const auto& patches = grid_.topology.patches;
     for (int pi = 0; pi < static_cast<int>(patches.size()); ++pi) {
       const auto& pt = patches[pi];
@@ -550,6 +582,8 @@ class euler_model {
           h.donor = linear_index<Dim>(donor, cells[h.donor_block]);
           owner_[b][h.padded] = -1 - static_cast<long long>(halos_.size());
           halos_.push_back(h);
+          if (pt.kind == boundary_kind::wall && opt_.wall == euler_options::wall_flux::extrapolated)
+            wall_flag_[b][d][h.face] = static_cast<signed char>(out);
         }
       }
     }
@@ -569,6 +603,7 @@ class euler_model {
   std::vector<std::array<std::size_t, Dim>> stride_;
   std::vector<std::vector<long long>> owner_;
   std::vector<halo_cell> halos_;
+  std::vector<std::array<std::vector<signed char>, Dim>> wall_flag_;
 };
 
 

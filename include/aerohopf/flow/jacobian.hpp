@@ -151,7 +151,8 @@ void assemble_jacobian(const euler_model<Dim>& m, const vec<double>& w, jacobian
       if (row_m >= 0) add_column(b, cell, row_m, dflux, -1.0 / vol_m);
       if (row_p >= 0) add_column(b, cell, row_p, dflux, 1.0 / vol_p);
     };
-    if (exact2) {
+    const int wall = m.wall_side(b, d, k);
+    if (exact2 || wall != 0) {
       const std::size_t sten[4] = {cm - s, cm, c0, c0 + s};
       std::array<primitive<jet, Dim>, 4> base;
       for (int p = 0; p < 4; ++p) base[p] = to_jet_prim(pb[sten[p]], -1);
@@ -160,7 +161,7 @@ void assemble_jacobian(const euler_model<Dim>& m, const vec<double>& w, jacobian
         for (int v = 0; v < nv; ++v) {
           auto qs = base;
           qs[p] = to_jet_prim(pb[sten[p]], v);
-          const auto fl = m.template face_flux4<jet>(qs[0], qs[1], qs[2], qs[3], area, q);
+          const auto fl = m.template face_flux4<jet>(qs[0], qs[1], qs[2], qs[3], area, q, wall);
           for (int u = 0; u < nv; ++u) dflux(u, v) = fl[u][1];
         }
         scatter(sten[p], dflux);
