@@ -65,6 +65,9 @@ struct euler_options {
   /// mirror image cannot: far less spurious entropy at a leading edge resolved by only 0.01 c
   /// cells). riemann: Osher flux between the cell and its mirror image.
   enum class wall_flux { extrapolated, riemann } wall = wall_flux::extrapolated;
+  /// Wall ghost cells: mirror (same pressure and density) or extrapolated_pressure (see
+  /// euler_model::halo_state).
+  enum class wall_ghost_kind { mirror, extrapolated_pressure } wall_ghost = wall_ghost_kind::extrapolated_pressure;
 };
 
 /// Force and moment coefficients (reference length 1, reference area 1 (2D: per unit span),
@@ -88,6 +91,7 @@ class euler_model {
     std::size_t padded;
     int donor_block;
     std::size_t donor;  // interior linear index in donor_block
+    std::size_t donor2; // second donor (same block): the other of the two wall cells; = donor otherwise
     boundary_kind kind;
     int dir;            // normal axis of the boundary face
     std::size_t face;   // index among the faces normal to dir (wall / far field)
@@ -239,10 +243,15 @@ class euler_model {
     return osher_flux<S, Dim>(ql, qr, area, q, star);
   }
 
-  /// Halo state of h from its donor's conservative state (the function whose derivative the
-  /// Jacobians chain in).
+  /// Halo state of h from its donors' conservative states (the function whose derivative the
+  /// Jacobians chain in). Wall ghosts: the velocity of the mirrored cell reflected about the
+  /// moving wall; with wall_ghost::extrapolated_pressure the pressure continues the profile of
+  /// the two wall cells geometrically, p_ghost(layer l) = p_0 (p_0 / p_1)^(l+1) (positive, and
+  /// it keeps the normal pressure gradient that a curved wall needs in the MUSCL slopes of the
+  /// first cells), and the density follows isentropically from the mirrored cell.
   template <class S>
-  state<S, Dim> halo_state(const halo_cell& h, const state<S, Dim>& donor, const grid_metrics<S, Dim>& m) const {
+  state<S, Dim> halo_state(const halo_cell& h, const state<S, Dim>& donor, const state<S, Dim>& donor2,
+                           const grid_metrics<S, Dim>& m) const {
     if (h.kind == boundary_kind::interface) return donor;
     const auto& s = m.blocks[h.block].normal[h.dir][h.face];
     const S& q = m.blocks[h.block].speed[h.dir][h.face];
@@ -255,6 +264,15 @@ class euler_model {
     if (h.kind == boundary_kind::wall) {
       const S un = dot<S, Dim>(qi.u, n) - sn;
       for (int d = 0; d < Dim; ++d) qi.u[d] -= S(2.0) * un * n[d];
+      if (opt_.wall_ghost == euler_options::wall_ghost_kind::extrapolated_pressure) {
+        const int layer = padded_layer(h);
+        const auto q2 = to_primitive<S, Dim>(donor2);
+        const S& p0 = layer == 0 ? qi.p : q2.p;
+        const S& p1 = layer == 0 ? q2.p : qi.p;
+        const S pg = p0 * internal::power(p0 / p1, double(layer + 1));
+        qi.rho *= internal::power(pg / qi.p, 1.0 / gamma_gas);
+        qi.p = pg;
+      }
       return to_conservative<S, Dim>(qi);
     }
     return to_conservative<S, Dim>(far_field_state<S>(qi, n, sn));
@@ -410,10 +428,14 @@ class euler_model {
       }
     }
     for (const auto& h : halos_) {
-      state<S, Dim> donor;
+      state<S, Dim> donor, donor2;
       const S* src = w + (offset_[h.donor_block] + h.donor) * nv;
-      for (int v = 0; v < nv; ++v) donor[v] = src[v];
-      padded[h.block][h.padded] = halo_state<S>(h, donor, m);
+      const S* src2 = w + (offset_[h.donor_block] + h.donor2) * nv;
+      for (int v = 0; v < nv; ++v) {
+        donor[v] = src[v];
+        donor2[v] = src2[v];
+      }
+      padded[h.block][h.padded] = halo_state<S>(h, donor, donor2, m);
     }
   }
 
@@ -580,6 +602,12 @@ class euler_model {
             donor[dd] = dside ? cells[db][dd] - 1 - layer : layer;
           }
           h.donor = linear_index<Dim>(donor, cells[h.donor_block]);
+          h.donor2 = h.donor;
+          if (pt.kind == boundary_kind::wall) {
+            index_d<Dim> other = c;
+            other[d] -= out * (1 - layer);
+            h.donor2 = linear_index<Dim>(other, cells[b]);
+          }
           owner_[b][h.padded] = -1 - static_cast<long long>(halos_.size());
           halos_.push_back(h);
           if (pt.kind == boundary_kind::wall && opt_.wall == euler_options::wall_flux::extrapolated)

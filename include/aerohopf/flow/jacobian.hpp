@@ -60,6 +60,17 @@ Eigen::Index column_of(const euler_model<Dim>& m, int b, std::size_t padded) {
   return static_cast<Eigen::Index>(m.cell_offset(h.donor_block) + h.donor);
 }
 
+/// All global columns a padded cell depends on (one, or two for a wall ghost).
+template <int Dim>
+std::vector<Eigen::Index> columns_of(const euler_model<Dim>& m, int b, std::size_t padded) {
+  const long long o = m.padded_owner(b, padded);
+  if (o >= 0) return {static_cast<Eigen::Index>(o)};
+  require(o != euler_model<Dim>::unused_cell, "jacobian: stencil reaches an unused corner halo cell");
+  const auto& h = m.halos()[static_cast<std::size_t>(-1 - o)];
+  const auto base = static_cast<Eigen::Index>(m.cell_offset(h.donor_block));
+  return {base + static_cast<Eigen::Index>(h.donor), base + static_cast<Eigen::Index>(h.donor2)};
+}
+
 }  // namespace internal
 
 /// Block pattern (cell row, cell column) of the chosen Jacobian.
@@ -74,9 +85,10 @@ std::vector<std::pair<Eigen::Index, Eigen::Index>> jacobian_pattern(const euler_
     if (wide) sten = {cm - s, cm, c0, c0 + s};
     const int n = m.metrics().blocks[b].cells[d];
     for (std::size_t q : sten) {
-      const auto col = internal::column_of<Dim>(m, b, q);
-      if (f > 0) pairs.emplace_back(internal::column_of<Dim>(m, b, cm), col);
-      if (f < n) pairs.emplace_back(internal::column_of<Dim>(m, b, c0), col);
+      for (const auto col : internal::columns_of<Dim>(m, b, q)) {
+        if (f > 0) pairs.emplace_back(internal::column_of<Dim>(m, b, cm), col);
+        if (f < n) pairs.emplace_back(internal::column_of<Dim>(m, b, c0), col);
+      }
     }
   });
   return pairs;
@@ -100,7 +112,7 @@ void assemble_jacobian(const euler_model<Dim>& m, const vec<double>& w, jacobian
 
   // dg/dw_donor of every halo cell (identity across interfaces).
   const auto jet_metrics = euler_model<Dim>::template convert_metrics<jet>(met);
-  std::vector<block> dhalo(m.halos().size());
+  std::vector<block> dhalo(m.halos().size()), dhalo2(m.halos().size());
   for (std::size_t k = 0; k < m.halos().size(); ++k) {
     const auto& h = m.halos()[k];
     if (h.kind == boundary_kind::interface) {
@@ -108,11 +120,21 @@ void assemble_jacobian(const euler_model<Dim>& m, const vec<double>& w, jacobian
       continue;
     }
     const double* src = w.data() + (m.cell_offset(h.donor_block) + h.donor) * nv;
+    const double* src2 = w.data() + (m.cell_offset(h.donor_block) + h.donor2) * nv;
     for (int v = 0; v < nv; ++v) {
-      state<jet, Dim> donor;
-      for (int u = 0; u < nv; ++u) donor[u] = jet::variable(src[u], u == v ? 1.0 : 0.0);
-      const auto g = m.template halo_state<jet>(h, donor, jet_metrics);
+      state<jet, Dim> donor, donor2, c1, c2;
+      for (int u = 0; u < nv; ++u) {
+        donor[u] = jet::variable(src[u], u == v ? 1.0 : 0.0);
+        c2[u] = jet(src2[u]);
+        c1[u] = jet(src[u]);
+        donor2[u] = jet::variable(src2[u], u == v ? 1.0 : 0.0);
+      }
+      const auto g = m.template halo_state<jet>(h, donor, c2, jet_metrics);
       for (int u = 0; u < nv; ++u) dhalo[k](u, v) = g[u][1];
+      if (h.donor2 != h.donor) {
+        const auto g2 = m.template halo_state<jet>(h, c1, donor2, jet_metrics);
+        for (int u = 0; u < nv; ++u) dhalo2[k](u, v) = g2[u][1];
+      }
     }
   }
 
@@ -124,6 +146,8 @@ void assemble_jacobian(const euler_model<Dim>& m, const vec<double>& w, jacobian
       const auto hk = static_cast<std::size_t>(-1 - o);
       const auto& h = m.halos()[hk];
       a.block(row, static_cast<Eigen::Index>(m.cell_offset(h.donor_block) + h.donor)) += scale * (d * dhalo[hk]);
+      if (h.donor2 != h.donor)
+        a.block(row, static_cast<Eigen::Index>(m.cell_offset(h.donor_block) + h.donor2)) += scale * (d * dhalo2[hk]);
     }
   };
   auto to_jet_prim = [](const state<double, Dim>& s, int seed) {
