@@ -17,7 +17,7 @@
 using namespace aerohopf;
 using C = std::complex<double>;
 
-static_assert(aerohopf::system<hopf_normal_form>);
+static_assert(aerohopf::dynamical_system<hopf_normal_form>);
 static_assert(system_over<hopf_normal_form, dd_real>);
 static_assert(system_over<hopf_normal_form, qd_real>);
 static_assert(system_over<hopf_normal_form, taylor<double, 3>>);

@@ -114,7 +114,7 @@ inline double relative(double num, double den) { return den > 0 ? num / den : nu
 }  // namespace internal
 
 /// The coefficients of the reduced model at the Hopf point hp (spec 03).
-template <system S, class Provider = taylor_products<double>>
+template <dynamical_system S, class Provider = taylor_products<double>>
   requires derivative_product_provider<Provider, S>
 centre_manifold_coefficients reduce_to_centre_manifold(const S& s, const hopf_point& hp,
                                                        const Provider& provider = Provider{},

@@ -83,7 +83,7 @@ struct fd_products {
     return s.residual(w, mu);
   }
 
-  template <system S>
+  template <dynamical_system S>
     requires system_over<S, T>
   vec<double> second(const S& s, const vec<double>& w0, double mu, const vec<double>& v) const {
     internal::check_direction(s, w0, mu, v, "fd_products::second");
@@ -98,7 +98,7 @@ struct fd_products {
     return internal::to_double_vec(b);
   }
 
-  template <system S>
+  template <dynamical_system S>
     requires system_over<S, T>
   vec<double> third(const S& s, const vec<double>& w0, double mu, const vec<double>& v) const {
     internal::check_direction(s, w0, mu, v, "fd_products::third");
@@ -124,7 +124,7 @@ struct taylor_products {
 
   std::string name() const { return "taylor<" + std::string(scalar_traits<T>::name()) + ">"; }
 
-  template <system S>
+  template <dynamical_system S>
     requires system_over<S, jet>
   jet_products products(const S& s, const vec<double>& w0, double mu, const vec<double>& v) const {
     internal::check_direction(s, w0, mu, v, "taylor_products");
@@ -140,12 +140,12 @@ struct taylor_products {
     }
     return r;
   }
-  template <system S>
+  template <dynamical_system S>
     requires system_over<S, jet>
   vec<double> second(const S& s, const vec<double>& w0, double mu, const vec<double>& v) const {
     return products(s, w0, mu, v).b_vv;
   }
-  template <system S>
+  template <dynamical_system S>
     requires system_over<S, jet>
   vec<double> third(const S& s, const vec<double>& w0, double mu, const vec<double>& v) const {
     return products(s, w0, mu, v).c_vvv;
@@ -155,13 +155,13 @@ struct taylor_products {
 /// A type that gives B(v, v) and C(v, v, v) of system S (fd_products, taylor_products, ...).
 template <class P, class S>
 concept derivative_product_provider =
-    system<S> && requires(const P& p, const S& s, const vec<double>& w, double mu, const vec<double>& v) {
+    dynamical_system<S> && requires(const P& p, const S& s, const vec<double>& w, double mu, const vec<double>& v) {
       { p.second(s, w, mu, v) } -> std::convertible_to<vec<double>>;
       { p.third(s, w, mu, v) } -> std::convertible_to<vec<double>>;
     };
 
 /// Every derivative product of f at (w0, mu) that the reduction needs, from one provider.
-template <system S, class Provider>
+template <dynamical_system S, class Provider>
   requires derivative_product_provider<Provider, S>
 class derivative_products {
  public:

@@ -48,7 +48,7 @@ struct bdf2_step_info {
 
 /// Integrates from w0 at t0 to t_end; calls observer(const bdf2_step_info&, const vec<double>& w)
 /// at the start and after every step; returns w(t_end).
-template <system S, class Observer>
+template <dynamical_system S, class Observer>
 vec<double> integrate_bdf2(const S& s, double mu, vec<double> w0, double t0, double t_end, const bdf2_options& opt,
                            Observer&& observer) {
   const char* who = "integrate_bdf2";
@@ -112,13 +112,13 @@ vec<double> integrate_bdf2(const S& s, double mu, vec<double> w0, double t0, dou
   return w;
 }
 
-template <system S>
+template <dynamical_system S>
 vec<double> integrate_bdf2(const S& s, double mu, vec<double> w0, double t0, double t_end, const bdf2_options& opt) {
   return integrate_bdf2(s, mu, std::move(w0), t0, t_end, opt, [](const bdf2_step_info&, const vec<double>&) {});
 }
 
 /// BDF2 run storing every store_every-th step (and always the first and the last).
-template <system S>
+template <dynamical_system S>
 time_history<vec<double>> bdf2_history(const S& s, double mu, vec<double> w0, double t0, double t_end,
                                        const bdf2_options& opt, long store_every = 1) {
   require(store_every >= 1, "bdf2_history: store_every must be >= 1 (got ", store_every, ")");

@@ -83,7 +83,7 @@ time_history<State> rk4_history(Rhs&& f, State y0, double t0, double t_end, doub
 }
 
 /// The callable (t, w) -> f(w, mu) of a system at fixed mu (autonomous; holds a reference to s).
-template <system S>
+template <dynamical_system S>
 auto system_rhs(const S& s, double mu) {
   return [&s, mu](double, const vec<double>& w) -> vec<double> { return s.residual(w, mu); };
 }
