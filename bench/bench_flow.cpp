@@ -16,7 +16,7 @@ using namespace aerohopf::flow;
 
 namespace {
 
-const euler_model<2>& model(int stride) {
+euler_model<2>& model(int stride) {
   static const auto fine = naca_cgrid();
   static std::map<int, euler_model<2>> models;
   auto it = models.find(stride);
@@ -62,7 +62,7 @@ void bm_jacobian(benchmark::State& st) {
 }
 
 void bm_steady_medium(benchmark::State& st) {
-  const auto& m = model(2);
+  auto& m = model(2);
   for (auto _ : st) {
     auto w = m.free_stream_vector();
     steady_options opt;

@@ -48,7 +48,9 @@ int main(int argc, char** argv) {
   forces << "grid,cells,mach,alpha_deg,cl,cd,cm,iterations,seconds\n";
   auto run = [&](const level& lev, double mach, double alpha_deg, bool vtk) {
     const auto grid = coarsen(fine, lev.stride);
-    euler_model<2> model(grid, {.mach = mach, .alpha_rad = alpha_deg * std::numbers::pi / 180.0});
+    euler_options eo;
+    eo.vortex_far_field = true;  // compressible point-vortex far field (see README)
+    euler_model<2> model(grid, {.mach = mach, .alpha_rad = alpha_deg * std::numbers::pi / 180.0}, eo);
     auto w = model.free_stream_vector();
     steady_options opt;
     opt.exact_switch_drop = 1e-3;

@@ -29,6 +29,7 @@
 
 #include <array>
 #include <cmath>
+#include <numbers>
 #include <string>
 #include <vector>
 
@@ -68,6 +69,12 @@ struct euler_options {
   /// Wall ghost cells: mirror (same pressure and density) or extrapolated_pressure (see
   /// euler_model::halo_state).
   enum class wall_ghost_kind { mirror, extrapolated_pressure } wall_ghost = wall_ghost_kind::extrapolated_pressure;
+  /// 2D only: far-field state = free stream plus the compressible point vortex of the current
+  /// circulation (set_circulation), centred at moment_centre (Thomas & Salas, AIAA J. 24(7),
+  /// 1986). Removes most of the lift error of a near far field (15 chords). The circulation is
+  /// a PARAMETER of the residual (the Jacobians do not differentiate it); solve_steady updates
+  /// it to CL/2 every step, so at convergence it is consistent.
+  bool vortex_far_field = false;
 };
 
 /// Force and moment coefficients (reference length 1, reference area 1 (2D: per unit span),
@@ -92,6 +99,7 @@ class euler_model {
     int donor_block;
     std::size_t donor;  // interior linear index in donor_block
     std::size_t donor2; // second donor (same block): the other of the two wall cells; = donor otherwise
+    std::size_t patch_face;  // index into the far-field face centres
     boundary_kind kind;
     int dir;            // normal axis of the boundary face
     std::size_t face;   // index among the faces normal to dir (wall / far field)
@@ -131,6 +139,31 @@ class euler_model {
               "set_grid_motion: block ", b, " has a different shape");
     grid_.points = points;
     metrics_ = std::move(m);
+    for (const auto& h : halos_) {
+      const auto p = unravel<Dim>(h.face, metrics_.blocks[h.block].face_dims(h.dir));
+      far_centre_[h.patch_face] = internal::face_centre<double, Dim>(grid_.points.blocks[h.block], h.dir, p);
+    }
+  }
+
+  /// Circulation of the far-field point vortex (used with options().vortex_far_field).
+  void set_circulation(double gamma) { circulation_ = gamma; }
+  double circulation() const { return circulation_; }
+
+  /// Free stream plus the compressible point vortex (2D): isentropic, same total enthalpy.
+  primitive<double, Dim> vortex_free_stream(const std::array<double, Dim>& x) const {
+    const double m = fs_.mach, a = fs_.alpha_rad, beta = std::sqrt(1.0 - m * m);
+    const double dx = x[0] - opt_.moment_centre[0], dy = x[1] - opt_.moment_centre[1];
+    const double r = std::hypot(dx, dy), th = std::atan2(dy, dx);
+    const double s = std::sin(th - a);
+    const double k = circulation_ * beta / (2.0 * std::numbers::pi * r * (1.0 - m * m * s * s));
+    primitive<double, Dim> q{};
+    q.u[0] = std::cos(a) + k * std::sin(th);
+    q.u[1] = std::sin(a) - k * std::cos(th);
+    const double cinf2 = 1.0 / (m * m);
+    const double c2 = cinf2 + 0.5 * (gamma_gas - 1.0) * (1.0 - q.u[0] * q.u[0] - q.u[1] * q.u[1]);
+    q.rho = std::pow(c2 / cinf2, 1.0 / (gamma_gas - 1.0));
+    q.p = fs_.pressure() * std::pow(c2 / cinf2, gamma_gas / (gamma_gas - 1.0));
+    return q;
   }
 
   /// Uniform free-stream state vector.
@@ -275,15 +308,22 @@ class euler_model {
       }
       return to_conservative<S, Dim>(qi);
     }
-    return to_conservative<S, Dim>(far_field_state<S>(qi, n, sn));
+    return to_conservative<S, Dim>(far_field_state<S>(qi, n, sn, &far_centre_[h.patch_face]));
   }
 
   /// Characteristic far-field state (1D Riemann invariants normal to the boundary, in the
   /// frame of the moving boundary; entropy and tangential velocity upwinded).
   template <class S>
-  primitive<S, Dim> far_field_state(const primitive<S, Dim>& qi, const vector_d<S, Dim>& n, const S& sn) const {
+  primitive<S, Dim> far_field_state(const primitive<S, Dim>& qi, const vector_d<S, Dim>& n, const S& sn,
+                                    const std::array<double, Dim>* where = nullptr) const {
     constexpr double gm1 = gamma_gas - 1.0;
-    const auto qf = fs_.primitive_state<S, Dim>();
+    auto qf = fs_.primitive_state<S, Dim>();
+    if constexpr (Dim == 2) {
+      if (where && opt_.vortex_far_field && circulation_ != 0.0) {
+        const auto v = vortex_free_stream(*where);
+        qf = {S(v.rho), {S(v.u[0]), S(v.u[1])}, S(v.p)};
+      }
+    }
     const S ci = sound_speed(qi), cf = sound_speed(qf);
     const S ui = dot<S, Dim>(qi.u, n) - sn, uf = dot<S, Dim>(qf.u, n) - sn;
     if (uf <= -cf) return qf;  // supersonic inflow
@@ -609,6 +649,8 @@ class euler_model {
             h.donor2 = linear_index<Dim>(other, cells[b]);
           }
           owner_[b][h.padded] = -1 - static_cast<long long>(halos_.size());
+          h.patch_face = far_centre_.size();
+          far_centre_.push_back(internal::face_centre<double, Dim>(grid_.points.blocks[b], d, fidx));
           halos_.push_back(h);
           if (pt.kind == boundary_kind::wall && opt_.wall == euler_options::wall_flux::extrapolated)
             wall_flag_[b][d][h.face] = static_cast<signed char>(out);
@@ -625,6 +667,8 @@ class euler_model {
   multiblock_grid<Dim> grid_;
   free_stream fs_;
   euler_options opt_;
+  double circulation_ = 0.0;
+  std::vector<std::array<double, Dim>> far_centre_;  // face centre of each halo's boundary face
   grid_metrics<double, Dim> metrics_;
   std::vector<std::size_t> offset_;
   std::vector<index_d<Dim>> pdims_;

@@ -72,10 +72,11 @@ bool physical_state(const euler_model<Dim>& m, const vec<double>& w) {
   return true;
 }
 
-/// Drives w (in: initial guess, out: converged state) to R(w) = 0. Throws convergence_error if
+/// Drives w (in: initial guess, out: converged state) to R(w) = 0. With the vortex far field the
+/// model's circulation is updated (hence the non-const model). Throws convergence_error if
 /// the residual has not dropped by residual_drop after max_steps (the state reached is kept in w).
 template <int Dim>
-steady_report solve_steady(const euler_model<Dim>& m, vec<double>& w, const steady_options& opt = {}) {
+steady_report solve_steady(euler_model<Dim>& m, vec<double>& w, const steady_options& opt = {}) {
   constexpr int nv = Dim + 2;
   require(w.size() == m.size(), "solve_steady: state has ", w.size(), " entries, model has ", m.size());
   require(physical_state<Dim>(m, w), "solve_steady: initial state has non-positive density or pressure");
@@ -87,6 +88,8 @@ steady_report solve_steady(const euler_model<Dim>& m, vec<double>& w, const stea
   bool analysed = false;
   jacobian_kind kind = jacobian_kind::modified_order;
   steady_report rep;
+  const bool vortex = Dim == 2 && m.options().vortex_far_field;
+  if (vortex) m.set_circulation(0.5 * m.forces(w).cl);
   vec<double> r = m.residual(w);
   double res = r.norm() / rootn;
   require(std::isfinite(res), "solve_steady: residual of the initial state is not finite");
@@ -142,9 +145,13 @@ steady_report solve_steady(const euler_model<Dim>& m, vec<double>& w, const stea
       continue;
     }
     w = std::move(wn);
+    const double cl = m.forces(w).cl;
+    if (vortex) {
+      m.set_circulation(0.5 * cl);  // lagged: consistent at convergence
+      rn = m.residual(w);
+    }
     r = std::move(rn);
     res = r.norm() / rootn;
-    const double cl = m.forces(w).cl;
     rep.history.push_back({step, res, cfl, lin.iterations, cl});
     rep.steps = step;
     if (opt.log) {
