@@ -208,6 +208,17 @@ class block_ilu {
       row_ptr_[i + 1] = static_cast<int>(col_.size());
     }
     col_.shrink_to_fit();
+    // storage slots: the L parts of the rows in row order, then the U parts (diagonal first) in
+    // REVERSE row order, so that both triangular sweeps stream through memory forwards (a
+    // backward-running stream was measured 2x slower on the hardware prefetchers).
+    slot_.resize(col_.size());
+    {
+      int next_slot = 0;
+      for (int i = 0; i < n; ++i)
+        for (int q = row_ptr_[i]; q < diag_[i]; ++q) slot_[q] = next_slot++;
+      for (int i = n - 1; i >= 0; --i)
+        for (int q = diag_[i]; q < row_ptr_[i + 1]; ++q) slot_[q] = next_slot++;
+    }
 
     // where each block of a goes in the factor storage (-1: dropped by the filter)
     source_.assign(ac.size(), -1);
@@ -216,7 +227,7 @@ class block_ilu {
         if (opt_.filter.keep(i, ac[p])) {
           const int ni = new_of(i), nj = new_of(ac[p]);
           const auto first = col_.begin() + row_ptr_[ni], last = col_.begin() + row_ptr_[ni + 1];
-          source_[p] = static_cast<int>(std::lower_bound(first, last, nj) - col_.begin());
+          source_[p] = slot_[std::lower_bound(first, last, nj) - col_.begin()];
         }
     val_.assign(col_.size() * bs_ * bs_, Scalar(0.0));
     pos_.assign(n, -1);
@@ -279,19 +290,29 @@ class block_ilu {
         Eigen::Map<segment_type>(w + index(i) * b, b) = r.template segment<B>(index(perm_[i]) * b, b);
     if constexpr (internal::has_fast_block_kernel_v<Scalar, B>) {
       const Scalar* v = val_.data();
+      const int* rp = row_ptr_.data();
+      const int* dg = diag_.data();
+      const int* cl = col_.data();
+      const int* sl = slot_.data();
       for (int i = 0; i < n_; ++i) {  // forward: L y = r (unit block diagonal)
+        Scalar acc[B];
         Scalar* wi = w + index(i) * B;
-        for (int q = row_ptr_[i]; q < diag_[i]; ++q)
-          internal::block_gemv<-1, B>(v + index(q) * B * B, w + index(col_[q]) * B, wi);
+        for (int r = 0; r < B; ++r) acc[r] = wi[r];
+        const Scalar* lv = v + index(sl[rp[i]]) * B * B;  // L part of row i is contiguous
+        for (int q = rp[i]; q < dg[i]; ++q, lv += B * B) internal::block_gemv<-1, B>(lv, w + index(cl[q]) * B, acc);
+        for (int r = 0; r < B; ++r) wi[r] = acc[r];
       }
       for (int i = n_ - 1; i >= 0; --i) {  // backward: U x = y, diagonal stored inverted
         Scalar acc[B];
         Scalar* wi = w + index(i) * B;
         for (int r = 0; r < B; ++r) acc[r] = wi[r];
-        for (int q = diag_[i] + 1; q < row_ptr_[i + 1]; ++q)
-          internal::block_gemv<-1, B>(v + index(q) * B * B, w + index(col_[q]) * B, acc);
-        for (int r = 0; r < B; ++r) wi[r] = Scalar(0.0);
-        internal::block_gemv<1, B>(v + index(diag_[i]) * B * B, acc, wi);
+        const Scalar* uv = v + index(sl[dg[i]]) * B * B;  // diagonal, then the U part of row i
+        for (int q = dg[i] + 1; q < rp[i + 1]; ++q)
+          internal::block_gemv<-1, B>(uv + (q - dg[i]) * B * B, w + index(cl[q]) * B, acc);
+        Scalar out[B];
+        for (int r = 0; r < B; ++r) out[r] = Scalar(0.0);
+        internal::block_gemv<1, B>(uv, acc, out);
+        for (int r = 0; r < B; ++r) wi[r] = out[r];
       }
     } else {
       segment_type acc(b);
@@ -327,8 +348,9 @@ class block_ilu {
   bool same_pattern(const matrix_type& a) const {
     return a.block_rows() == n_ && a.block_size() == bs_ && a.row_ptr() == a_row_ptr_ && a.col_index() == a_col_;
   }
-  block_map blk(int q) { return block_map(val_.data() + index(q) * bs_ * bs_, bs_, bs_); }
-  const_block_map cblk(int q) const { return const_block_map(val_.data() + index(q) * bs_ * bs_, bs_, bs_); }
+  // block at logical (CSR) position q
+  block_map blk(int q) { return block_map(val_.data() + index(slot_[q]) * bs_ * bs_, bs_, bs_); }
+  const_block_map cblk(int q) const { return const_block_map(val_.data() + index(slot_[q]) * bs_ * bs_, bs_, bs_); }
 
   void invert_pivot(int i) {
     block_map d = blk(diag_[i]);
@@ -350,7 +372,7 @@ class block_ilu {
   int n_ = 0;
   std::vector<int> a_row_ptr_, a_col_;  // pattern of the analysed matrix
   std::vector<int> perm_, inv_;
-  std::vector<int> row_ptr_, col_, diag_, source_;
+  std::vector<int> row_ptr_, col_, diag_, source_, slot_;
   std::vector<Scalar> val_;
   std::vector<int> pos_;
   mutable vector_type work_;
