@@ -16,11 +16,13 @@
 // Discretisation: Osher flux (osher_flux.hpp) between MUSCL/van Albada states of the
 // primitive variables (muscl.hpp), dimension by dimension, so each face flux depends on the 4
 // cells along its grid line and each cell row of the exact Jacobian has 4 Dim + 1 blocks.
-// Boundaries use 2 layers of halo cells; every halo cell is a function of ONE interior cell
-// (its donor): a copy across block interfaces (incl. the C-grid wake cut), a mirror image for
-// a moving slip wall (velocity reflected relative to the wall's normal speed), and the
-// Riemann-invariant far-field state built from the adjacent interior cell. The Jacobians
-// (jacobian.hpp) add the chain-rule term dF/dw_halo * dw_halo/dw_donor for them.
+// Boundaries use 2 layers of halo cells; every halo cell is a function of at most two interior
+// cells (its donors): a copy across block interfaces (incl. the C-grid wake cut), a mirror
+// image for a moving slip wall (velocity reflected relative to the wall's normal speed,
+// pressure extrapolated from the two wall cells), and the Riemann-invariant far-field state
+// built from the adjacent interior cell. The slip-wall face itself carries the pure pressure
+// flux with p_w = (3 p_0 - p_1)/2. The Jacobians (jacobian.hpp) add the chain-rule terms
+// dF/dw_halo * dw_halo/dw_donor.
 //
 // Scalars: residual() is a template, so double, dd_real, qd_real and taylor<> states AND
 // grids (metrics computed from taylor<> points, e.g. a grid moved by a structural state) flow
