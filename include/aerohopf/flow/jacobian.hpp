@@ -5,7 +5,7 @@
 // Exact: each face flux F(w_{-2}, w_{-1}, w_{+1}, w_{+2}) depends on the 4 cells along its grid
 // line through MUSCL, so a cell row has 4 Dim + 1 blocks (9 in 2D, 13 in 3D). The 4 blocks
 // dF/dw_k are obtained by local forward-mode AD of the SAME templated face function that the
-// residual uses (taylor<double, 1>, one pass per unknown of the stencil): exact to rounding
+// residual uses (dual<4 (Dim+2)>: one pass gives all stencil derivatives): exact to rounding
 // and never out of sync with the residual.
 // Modified order: MUSCL dependence dropped, dF/dw_{-1} = dF/dw_l and dF/dw_{+1} = dF/dw_r at
 // the MUSCL states (2 Dim + 1 blocks). With order 1 both coincide with the exact Jacobian of
@@ -21,6 +21,7 @@
 
 #include "../linalg/block_sparse_matrix.hpp"
 #include "../scalar/taylor.hpp"
+#include "dual.hpp"
 #include "euler_model.hpp"
 
 namespace aerohopf::flow {
@@ -150,11 +151,6 @@ void assemble_jacobian(const euler_model<Dim>& m, const vec<double>& w, jacobian
         a.block(row, static_cast<Eigen::Index>(m.cell_offset(h.donor_block) + h.donor2)) += scale * (d * dhalo2[hk]);
     }
   };
-  auto to_jet_prim = [](const state<double, Dim>& s, int seed) {
-    state<jet, Dim> j;
-    for (int u = 0; u < nv; ++u) j[u] = jet::variable(s[u], u == seed ? 1.0 : 0.0);
-    return to_primitive<jet, Dim>(j);
-  };
   const bool exact2 = kind == jacobian_kind::exact && m.options().order == 2;
   const bool muscl = m.options().order == 2;
   const double eps = m.options().limiter_eps;
@@ -163,9 +159,6 @@ void assemble_jacobian(const euler_model<Dim>& m, const vec<double>& w, jacobian
     const auto& mb = met.blocks[b];
     const std::size_t s = m.stride(b, d);
     const auto& pb = padded[b];
-    std::array<jet, Dim> area;
-    for (int e = 0; e < Dim; ++e) area[e] = jet(mb.normal[d][k][e]);
-    const jet q(mb.speed[d][k]);
     const int n = mb.cells[d];
     const Eigen::Index row_m = f > 0 ? internal::column_of<Dim>(m, b, cm) : -1;
     const Eigen::Index row_p = f < n ? internal::column_of<Dim>(m, b, c0) : -1;
@@ -177,17 +170,22 @@ void assemble_jacobian(const euler_model<Dim>& m, const vec<double>& w, jacobian
     };
     const int wall = m.wall_side(b, d, k);
     if (exact2 || wall != 0) {
+      // one dual pass: derivatives with respect to the 4 nv unknowns of the stencil
+      using D4 = dual<4 * nv>;
       const std::size_t sten[4] = {cm - s, cm, c0, c0 + s};
-      std::array<primitive<jet, Dim>, 4> base;
-      for (int p = 0; p < 4; ++p) base[p] = to_jet_prim(pb[sten[p]], -1);
+      std::array<primitive<D4, Dim>, 4> qs;
+      for (int p = 0; p < 4; ++p) {
+        state<D4, Dim> wd;
+        for (int u = 0; u < nv; ++u) wd[u] = D4::variable(pb[sten[p]][u], p * nv + u);
+        qs[p] = to_primitive<D4, Dim>(wd);
+      }
+      std::array<D4, Dim> area_d;
+      for (int e = 0; e < Dim; ++e) area_d[e] = D4(mb.normal[d][k][e]);
+      const auto fl = m.template face_flux4<D4>(qs[0], qs[1], qs[2], qs[3], area_d, D4(mb.speed[d][k]), wall);
       for (int p = 0; p < 4; ++p) {
         block dflux;
-        for (int v = 0; v < nv; ++v) {
-          auto qs = base;
-          qs[p] = to_jet_prim(pb[sten[p]], v);
-          const auto fl = m.template face_flux4<jet>(qs[0], qs[1], qs[2], qs[3], area, q, wall);
-          for (int u = 0; u < nv; ++u) dflux(u, v) = fl[u][1];
-        }
+        for (int u = 0; u < nv; ++u)
+          for (int v = 0; v < nv; ++v) dflux(u, v) = fl[u].d[p * nv + v];
         scatter(sten[p], dflux);
       }
     } else {
@@ -198,16 +196,22 @@ void assemble_jacobian(const euler_model<Dim>& m, const vec<double>& w, jacobian
         qr = muscl_right<double, Dim>(to_primitive<double, Dim>(pb[cm]), qr, to_primitive<double, Dim>(pb[c0 + s]), eps);
       }
       const auto wl = to_conservative<double, Dim>(ql), wr = to_conservative<double, Dim>(qr);
-      const auto jl = to_jet_prim(wl, -1), jr = to_jet_prim(wr, -1);
-      block dl, dr;
-      for (int v = 0; v < nv; ++v) {
-        const auto fl = osher_flux<jet, Dim>(to_jet_prim(wl, v), jr, area, q);
-        const auto fr = osher_flux<jet, Dim>(jl, to_jet_prim(wr, v), area, q);
-        for (int u = 0; u < nv; ++u) {
-          dl(u, v) = fl[u][1];
-          dr(u, v) = fr[u][1];
-        }
+      using D2 = dual<2 * nv>;
+      state<D2, Dim> wld, wrd;
+      for (int u = 0; u < nv; ++u) {
+        wld[u] = D2::variable(wl[u], u);
+        wrd[u] = D2::variable(wr[u], nv + u);
       }
+      std::array<D2, Dim> area_d;
+      for (int e = 0; e < Dim; ++e) area_d[e] = D2(mb.normal[d][k][e]);
+      const auto fl = osher_flux<D2, Dim>(to_primitive<D2, Dim>(wld), to_primitive<D2, Dim>(wrd), area_d,
+                                          D2(mb.speed[d][k]));
+      block dl, dr;
+      for (int u = 0; u < nv; ++u)
+        for (int v = 0; v < nv; ++v) {
+          dl(u, v) = fl[u].d[v];
+          dr(u, v) = fl[u].d[nv + v];
+        }
       scatter(cm, dl);
       scatter(c0, dr);
     }
