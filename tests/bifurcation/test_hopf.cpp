@@ -58,7 +58,9 @@ TEST_P(reactor_hopf, BothHopfPointsMatchDenseSpectrumCrossing) {
   // stable from its fold on, so only the first Hopf point exists there.
   ASSERT_EQ(hopfs.size(), GetParam() >= 32 ? 2u : 1u);
   EXPECT_NEAR(hopfs[0].mu, 0.165, 0.01);
-  if (hopfs.size() > 1) EXPECT_NEAR(hopfs[1].mu, 0.180, 0.005);
+  if (hopfs.size() > 1) {
+    EXPECT_NEAR(hopfs[1].mu, 0.180, 0.005);
+  }
   for (const auto& h : hopfs) {
     const double d = 2e-4;
     const double mu_ref = bisect_crossing(r, h.w, h.mu - d, h.mu + d);

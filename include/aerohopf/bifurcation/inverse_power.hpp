@@ -12,14 +12,16 @@
 //
 // Eigenvalue estimate: with C = A - sigma I and C y = x, the Rayleigh quotient of C on y is
 // <y, C y>/<y, y> = <y, x>/<y, y>, so lambda = sigma + <y, x>/<y, y>.
-// Convergence: ||A x - lambda x||_2 <= tolerance * max(1, |lambda|, ||A||_inf) with ||x||_2 = 1
-// (the residual cannot drop below about eps ||A||: stiff discretisations have a large ||A||).
+// Convergence: ||A x - lambda x||_2 <= max(tolerance max(1, |lambda|), 100 eps ||A||_inf) with
+// ||x||_2 = 1: the residual cannot drop below about eps ||A|| (stiff discretisations have a
+// large ||A||, e.g. 1/h^2).
 #include <Eigen/Core>
 
 #include <algorithm>
 #include <cmath>
 #include <complex>
 #include <iostream>
+#include <limits>
 
 #include "../error.hpp"
 #include "../linalg/direct.hpp"
@@ -27,7 +29,7 @@
 namespace aerohopf {
 
 struct inverse_power_options {
-  double tolerance = 1e-12;  ///< on ||A x - lambda x||_2 / max(1, |lambda|, ||A||_inf), ||x||_2 = 1
+  double tolerance = 1e-12;  ///< on ||A x - lambda x||_2 / max(1, |lambda|), ||x||_2 = 1 (see above)
   int max_iterations = 100;
   bool verbose = false;
   std::ostream* log = &std::cout;
@@ -107,7 +109,8 @@ eigen_pair inverse_power_impl(const Matrix& a, std::complex<double> shift, const
     r.iterations = t;
     if (opt.verbose && opt.log)
       *opt.log << who << " it " << t << "  lambda " << r.lambda << "  residual " << r.residual << "\n";
-    if (r.residual <= opt.tolerance * std::max({1.0, std::abs(r.lambda), a_norm})) {
+    const double floor = 100 * std::numeric_limits<double>::epsilon() * a_norm;
+    if (r.residual <= std::max(opt.tolerance * std::max(1.0, std::abs(r.lambda)), floor)) {
       normalise_phase(x);
       r.vector = x;
       return r;

@@ -15,8 +15,10 @@
 // problem, the pseudo-arclength corrector and the augmented Hopf systems all use it.
 //
 // Convergence criterion (stated, checked, reported): ||F(x_k)||_2 <= abs_tolerance +
-// rel_tolerance ||F(x_0)||_2. Failure modes, all thrown as convergence_error naming the
-// iterate and residual unless throw_on_failure is false: non-finite residual or step,
+// rel_tolerance ||F(x_0)||_2, or, once the residual has reached its rounding floor (fine grids
+// have ||A|| ~ 1/h^2, so ||F|| cannot drop below about eps ||A|| ||x||), a full Newton step
+// with ||dx||_inf <= step_tolerance (1 + ||x||_inf). The report says which one held.
+// Failure modes, all thrown as convergence_error naming the iterate and residual unless throw_on_failure is false: non-finite residual or step,
 // growth beyond divergence_factor ||F(x_0)||, iteration limit. Under-relaxation: steps are
 // scaled by `relaxation` until ||F|| has dropped below relax_until ||F_0||, then full steps
 // (the start-up strategy reported for the augmented Hopf system); an optional backtracking
@@ -48,6 +50,7 @@ struct newton_step_info {
 struct newton_options {
   double abs_tolerance = 1e-10;
   double rel_tolerance = 0.0;
+  double step_tolerance = 1e-12;  ///< relative full-step size that also counts as converged
   int max_iterations = 50;
   double divergence_factor = 1e10;
   double relaxation = 1.0;     ///< initial step scaling psi in (0, 1]
@@ -141,6 +144,14 @@ newton_result newton_iterate(ResidualFn&& residual, StepFn&& solve_step, vec<dou
     rep.iterations = k;
     rep.residual_history.push_back(fn);
     rep.step_history.push_back(psi * dxn);
+    if (psi == 1.0 && dx.template lpNorm<Eigen::Infinity>() <= opt.step_tolerance * (1.0 + x.template lpNorm<Eigen::Infinity>()) &&
+        fn <= 1e6 * target) {
+      rep.converged = true;
+      rep.reason = internal::concat("step ||dx|| = ", psi * dxn, " at the rounding floor (||F|| = ", fn, ") after ",
+                                    rep.iterations, " iterations");
+      if (opt.observer) opt.observer({k, fn, psi * dxn, psi, &x});
+      break;
+    }
     if (relaxing && fn < opt.relax_until * f0) relaxing = false;
     if (opt.observer) opt.observer({k, fn, psi * dxn, psi, &x});
     if (fn > opt.divergence_factor * std::max(f0, 1e-300))
