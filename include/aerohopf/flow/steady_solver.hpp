@@ -38,7 +38,7 @@ struct steady_options {
   double linear_tolerance = 1e-2;     // relative tolerance of each GMRES solve
   int linear_max_iterations = 200;
   int restart = 60;
-  double exact_switch_drop = 1e-3;  // 0 = never;     // > 0: exact Jacobian once ||R||/||R_0|| < this
+  double exact_switch_drop = 1e-3;   // exact Jacobian once ||R||/||R_0|| < this (0: never)
   std::ostream* log = nullptr;        // progress line per step when set
 };
 
