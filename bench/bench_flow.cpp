@@ -38,6 +38,9 @@ euler_model<2>& model(int stride) {
 // trailing edge and tip, so the faces coincide off the wing), blended out linearly towards the
 // far field. y = 0 is a slip wall (symmetry). The far field is only a few chords away and
 // has no vortex correction: the forces are indicative; the case measures cost, not accuracy.
+// Sanity (checked once): volumes positive; CL(alpha = 0) ~ 3e-13 by symmetry; CL(1 deg) = 0.065
+// per wing area vs 0.062 from Helmbold's low-aspect-ratio lift slope (aspect ratio 3) with the
+// Prandtl-Glauert factor at M = 0.5.
 struct box_wing_sizes {
   int upstream = 6, chord = 12, downstream = 6;  // cells along x
   int span = 8, outboard = 4;                    // cells along y
