@@ -1,0 +1,264 @@
+#pragma once
+// The coupled aeroelastic system of spec 05: 2D Euler flow around a rigid aerofoil in pitch
+// and plunge, as one dynamical_system dw/dt = f(w, Ubar) for the Hopf and reduction code.
+//
+// State w = [w_f (4 per flow cell, euler_model ordering), w_s = (h, h', alpha, alpha')],
+// parameter mu = Ubar. Residual
+//     f_f = R_f(w_f; grid(w_s), grid speeds(w_s))       (rigid_motion.hpp moves the whole grid)
+//     f_s = M^{-1} (f_a(C_l, C_m) - K(Ubar) w_s)         (pitch_plunge.hpp)
+// Time scaling: the flow is non-dimensionalised by chord, rho_inf and U_inf, so its time unit
+// is c / U_inf, which is exactly the time unit of the structural equations of spec 05
+// (h/c, alpha, ' = d/d(t U_inf / c)); grid speeds are therefore d/dt of the moved points in
+// that unit, and both halves of f share one clock with no conversion factor. Ubar enters only
+// through K.
+// Loads: C_l (normal to the free stream) and C_m (nose-up, about the MOVED elastic axis
+// (x_ea, y_ea + h)) are integrated from the same wall pressure that the slip-wall flux uses,
+// p_w = (3 p_0 - p_1)/2, on the moved wall faces; so the loads are linear in the wall
+// pressures (A_sf exact) and consistent with the flow residual.
+// The residual is templated on the scalar: with taylor<> jets in w_s the moved grid, metrics
+// and Euler residual carry exact derivatives. Jacobian (Eigen sparse, exact):
+//   A_ff: flow::assemble_jacobian (exact or modified order) on the grid moved to w_s,
+//   [A_fs; A_ss]: one taylor<double,1> pass of the coupled residual per structural unknown
+//          (exact; includes the dependence of the loads on the moved geometry),
+//   A_sf: derivative of the wall-pressure integrals by local jets per wall cell.
+// d_mu and jacobian_d_mu are analytic: -M^{-1} dK/dUbar w_s and the 4x4 block -M^{-1} dK/dUbar.
+#include <Eigen/Core>
+#include <Eigen/SparseCore>
+
+#include <array>
+#include <cmath>
+#include <utility>
+#include <vector>
+
+#include "../coupling/rigid_motion.hpp"
+#include "../error.hpp"
+#include "../flow/euler_model.hpp"
+#include "../flow/jacobian.hpp"
+#include "../flow/metrics.hpp"
+#include "../linalg/direct.hpp"
+#include "../nonlinear/system.hpp"
+#include "../scalar/taylor.hpp"
+#include "../structure/pitch_plunge.hpp"
+
+namespace aerohopf::models {
+
+class aerofoil_system {
+ public:
+  using jacobian_type = Eigen::SparseMatrix<double>;
+  static constexpr int n_structure = 4;
+  static constexpr int nv = 4;
+
+  /// flow: the Euler model on the rest grid (free stream, options; its wall patches with
+  /// options().force_tag, or all walls if empty, carry the loads); structure: the section.
+  aerofoil_system(flow::euler_model<2> flow, structure::pitch_plunge structure)
+      : flow_(std::move(flow)), structure_(std::move(structure)) {
+    require(flow_.options().wall == flow::euler_options::wall_flux::extrapolated,
+            "aerofoil_system: the loads assume the extrapolated slip-wall flux (euler_options::wall)");
+    require(!flow_.options().vortex_far_field,
+            "aerofoil_system: vortex_far_field is a residual parameter not differentiated here; switch it off");
+    const auto& sp = structure_.parameters();
+    ea_ = {sp.x_ea, sp.y_ea};
+    nf_ = flow_.size();
+    const auto& opt = flow_.options();
+    const auto& topo = flow_.grid().topology;
+    for (const auto& h : flow_.halos()) {
+      if (h.kind != flow::boundary_kind::wall || flow_.padded_layer(h) != 0) continue;
+      if (!opt.force_tag.empty() && topo.patches[h.patch].tag != opt.force_tag) continue;
+      wall_face f;
+      f.block = h.block;
+      f.dir = h.dir;
+      f.face = h.face;
+      f.sign = h.sign;
+      f.cell0 = static_cast<Eigen::Index>(flow_.cell_offset(h.donor_block) + h.donor);
+      f.cell1 = static_cast<Eigen::Index>(flow_.cell_offset(h.donor_block) + h.donor2);
+      const auto p = flow::unravel<2>(h.face, flow_.metrics().blocks[h.block].face_dims(h.dir));
+      const auto corners = flow::internal::face_corners<2>(h.dir, p);
+      const auto& pts = flow_.grid().points.blocks[h.block].points;
+      for (int c = 0; c < 2; ++c) f.corner[c] = flow::linear_index<2>(corners[c], pts);
+      walls_.push_back(f);
+    }
+    require(!walls_.empty(), "aerofoil_system: the flow grid has no wall faces to integrate loads over");
+  }
+
+  Eigen::Index size() const { return nf_ + n_structure; }
+  Eigen::Index flow_size() const { return nf_; }
+  const flow::euler_model<2>& flow() const { return flow_; }
+  const structure::pitch_plunge& structure() const { return structure_; }
+
+  /// Uniform free stream with the section at rest: the equilibrium of a symmetric aerofoil at
+  /// zero incidence for every Ubar.
+  vec<double> free_stream_state() const {
+    vec<double> w = vec<double>::Zero(size());
+    w.head(nf_) = flow_.free_stream_vector();
+    return w;
+  }
+
+  template <class T>
+  coupling::rigid_pose<T> pose(const vec<T>& w) const {
+    return {w[nf_], w[nf_ + 1], w[nf_ + 2], w[nf_ + 3]};
+  }
+
+  /// Points and metrics of the grid moved to the structural part of w.
+  template <class T>
+  flow::grid_metrics<T, 2> moved_metrics(const vec<T>& w, flow::multiblock_points<T, 2>* points_out = nullptr) const {
+    flow::multiblock_points<T, 2> pts, spd;
+    coupling::rigid_grid_motion<T>(flow_.grid().points, pose<T>(w), ea_, pts, &spd);
+    auto m = flow::compute_metrics<T, 2>(pts, &spd);
+    if (points_out) *points_out = std::move(pts);
+    return m;
+  }
+
+  /// (C_l, C_m about the moved elastic axis) of state w.
+  template <class T>
+  std::pair<T, T> load_coefficients(const vec<T>& w) const {
+    flow::multiblock_points<T, 2> pts;
+    const auto m = moved_metrics<T>(w, &pts);
+    return loads<T>(m, pts, w);
+  }
+
+  template <class T>
+  vec<T> residual(const vec<T>& w, const T& mu) const {
+    require(w.size() == size(), "aerofoil_system::residual: state has ", w.size(), " entries, system has ", size());
+    flow::multiblock_points<T, 2> pts;
+    const auto m = moved_metrics<T>(w, &pts);
+    vec<T> r(size());
+    flow_.template residual<T>(m, w.data(), r.data());
+    const auto [cl, cm] = loads<T>(m, pts, w);
+    Eigen::Matrix<T, 4, 1> ws;
+    for (int i = 0; i < 4; ++i) ws[i] = w[nf_ + i];
+    const auto rs = structure_.rate<T>(ws, cl, cm, mu);
+    for (int i = 0; i < 4; ++i) r[nf_ + i] = rs[i];
+    return r;
+  }
+
+  jacobian_type jacobian(const vec<double>& w, double mu) const { return assemble(w, mu, flow::jacobian_kind::exact); }
+  /// Same with the modified-order flow block (left-hand side of Newton iterations).
+  jacobian_type approximate_jacobian(const vec<double>& w, double mu) const {
+    return assemble(w, mu, flow::jacobian_kind::modified_order);
+  }
+
+  vec<double> d_mu(const vec<double>& w, double mu) const {
+    check_state(*this, w, mu, "aerofoil_system::d_mu");
+    vec<double> r = vec<double>::Zero(size());
+    r.tail(4) = -structure_.mass_inverse() * structure_.stiffness_d_ubar(mu) * w.tail(4);
+    return r;
+  }
+  jacobian_type jacobian_d_mu(const vec<double>& w, double mu) const {
+    check_state(*this, w, mu, "aerofoil_system::jacobian_d_mu");
+    const Eigen::Matrix4d b = -structure_.mass_inverse() * structure_.stiffness_d_ubar(mu);
+    std::vector<Eigen::Triplet<double>> t;
+    for (int i = 0; i < 4; ++i)
+      for (int j = 0; j < 4; ++j) t.emplace_back(nf_ + i, nf_ + j, b(i, j));
+    jacobian_type a(size(), size());
+    a.setFromTriplets(t.begin(), t.end());
+    return a;
+  }
+
+ private:
+  struct wall_face {
+    int block, dir, sign;
+    std::size_t face;
+    Eigen::Index cell0, cell1;  // wall cell and the next one inwards (global cell indices)
+    std::array<std::size_t, 2> corner;
+  };
+
+  template <class T>
+  static T pressure_of(const T* wc) {
+    flow::state<T, 2> s;
+    for (int v = 0; v < nv; ++v) s[v] = wc[v];
+    return flow::to_primitive<T, 2>(s).p;
+  }
+
+  /// Load of one wall face: (dC_l, dC_m) per unit (p_w - p_inf) and the face's lever arm.
+  template <class T>
+  std::pair<T, T> face_load_per_pressure(const flow::grid_metrics<T, 2>& m, const flow::multiblock_points<T, 2>& pts,
+                                         const wall_face& f, const T& h) const {
+    const auto& s = m.blocks[f.block].normal[f.dir][f.face];
+    const T fx = T(2.0 * f.sign) * s[0], fy = T(2.0 * f.sign) * s[1];  // area outward from the fluid
+    const auto& x0 = pts.blocks[f.block].x[f.corner[0]];
+    const auto& x1 = pts.blocks[f.block].x[f.corner[1]];
+    const T rx = T(0.5) * (x0[0] + x1[0]) - T(ea_[0]);
+    const T ry = T(0.5) * (x0[1] + x1[1]) - T(ea_[1]) - h;
+    const double a = flow_.conditions().alpha_rad;
+    const T cl = fy * T(std::cos(a)) - fx * T(std::sin(a));
+    const T cm = -(rx * fy - ry * fx);  // nose-up = clockwise
+    return {cl, cm};
+  }
+
+  template <class T>
+  std::pair<T, T> loads(const flow::grid_metrics<T, 2>& m, const flow::multiblock_points<T, 2>& pts,
+                        const vec<T>& w) const {
+    const T pinf = T(flow_.conditions().pressure());
+    const T h = w[nf_];
+    T cl = T(0.0), cm = T(0.0);
+    for (const auto& f : walls_) {
+      const T p0 = pressure_of<T>(w.data() + f.cell0 * nv), p1 = pressure_of<T>(w.data() + f.cell1 * nv);
+      const T dp = T(1.5) * p0 - T(0.5) * p1 - pinf;
+      const auto [l, c] = face_load_per_pressure<T>(m, pts, f, h);
+      cl += l * dp;
+      cm += c * dp;
+    }
+    return {cl, cm};
+  }
+
+  jacobian_type assemble(const vec<double>& w, double mu, flow::jacobian_kind kind) const {
+    check_state(*this, w, mu, "aerofoil_system::jacobian");
+    std::vector<Eigen::Triplet<double>> t;
+    // A_ff on the moved grid.
+    const vec<double> wf = w.head(nf_);
+    block_sparse_matrix<double, nv> aff;
+    if (w.tail(4).isZero(0.0)) {
+      flow::assemble_jacobian<2>(flow_, wf, kind, aff);
+    } else {
+      flow::multiblock_points<double, 2> pts, spd;
+      coupling::rigid_grid_motion<double>(flow_.grid().points, pose<double>(w), ea_, pts, &spd);
+      flow::euler_model<2> moved = flow_;
+      moved.set_grid_motion(pts, &spd);
+      flow::assemble_jacobian<2>(moved, wf, kind, aff);
+    }
+    const auto sff = aff.to_sparse();
+    t.reserve(static_cast<std::size_t>(sff.nonZeros()) + 4 * static_cast<std::size_t>(size()) + 8 * 4 * walls_.size());
+    for (int k = 0; k < sff.outerSize(); ++k)
+      for (jacobian_type::InnerIterator it(sff, k); it; ++it) t.emplace_back(it.row(), it.col(), it.value());
+    // [A_fs; A_ss]: one jet pass per structural unknown.
+    using jet = taylor<double, 1>;
+    vec<jet> wj = w.cast<jet>();
+    for (int j = 0; j < 4; ++j) {
+      wj[nf_ + j] = jet::variable(w[nf_ + j], 1.0);
+      const vec<jet> rj = residual<jet>(wj, jet(mu));
+      wj[nf_ + j] = jet(w[nf_ + j]);
+      for (Eigen::Index i = 0; i < size(); ++i) t.emplace_back(i, nf_ + j, rj[i][1]);
+    }
+    // A_sf: loads are linear in the wall pressures; dp/dw of the wall cells by local jets.
+    flow::multiblock_points<double, 2> pts;
+    const auto m = moved_metrics<double>(w, &pts);
+    const auto& minv = structure_.mass_inverse();
+    const double pi = std::numbers::pi, mus = structure_.parameters().mu_s;
+    const double kl = 2.0 / (pi * mus), km = 4.0 / (pi * mus);
+    for (const auto& f : walls_) {
+      const auto [l, c] = face_load_per_pressure<double>(m, pts, f, w[nf_]);
+      for (int which = 0; which < 2; ++which) {
+        const Eigen::Index cell = which == 0 ? f.cell0 : f.cell1;
+        const double weight = which == 0 ? 1.5 : -0.5;
+        for (int v = 0; v < nv; ++v) {
+          std::array<jet, nv> wc;
+          for (int u = 0; u < nv; ++u) wc[u] = jet::variable(w[cell * nv + u], u == v ? 1.0 : 0.0);
+          const double dp = weight * pressure_of<jet>(wc.data())[1];
+          for (int i = 0; i < 4; ++i)
+            t.emplace_back(nf_ + i, cell * nv + v, (minv(i, 1) * kl * l + minv(i, 3) * km * c) * dp);
+        }
+      }
+    }
+    jacobian_type a(size(), size());
+    a.setFromTriplets(t.begin(), t.end());
+    return a;
+  }
+
+  flow::euler_model<2> flow_;
+  structure::pitch_plunge structure_;
+  std::array<double, 2> ea_{};
+  Eigen::Index nf_ = 0;
+  std::vector<wall_face> walls_;
+};
+
+}  // namespace aerohopf::models
