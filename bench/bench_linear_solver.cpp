@@ -12,7 +12,8 @@
 // (minimal compulsory traffic: matrix values + indices + each vector once).
 //
 // Own flags (removed before Google Benchmark parses the rest):
-//   --large               add 1M-cell cases (3D 100^3 b=5, 2D 1000^2 b=4; ~10 GB peak memory)
+//   --large               add 1M-cell cases (3D 100^3 b=5, 2D 1000^2 b=4; ~8 GB peak memory)
+//   --all-peers           Eigen IncompleteLUT peers on every matrix (default: the 24^3 one only)
 //   --write-mtx=DIR       write the generated matrices (A, real) as Matrix Market files
 //                         DIR/<matrix>.mtx (scalar coordinate format, padded size) and exit
 //   --load-mtx=FILE --mtx-block=B   also benchmark a Matrix Market matrix (real, square) with
@@ -50,6 +51,7 @@ double now() {
 
 struct config {
   bool large = false;
+  bool all_peers = false;  // Eigen IncompleteLUT peers on every matrix (slow)
   std::string write_mtx, load_mtx;
   int mtx_block = 5;
 } cfg;
@@ -455,10 +457,12 @@ void register_solve(const std::string& mname, std::function<problem<B>&()> get, 
 
 template <int B>
 void register_peers(const std::string& mname, std::function<problem<B>&()> get, std::vector<form> forms, double tol,
-                    std::vector<int> petsc_fills) {
+                    std::vector<int> petsc_fills, bool with_eigen = false) {
   const std::string bs = std::to_string(B);
   for (form f : forms) {
-    for (bool g : {false, true}) {
+    // Eigen's IncompleteLUT setup takes 20-90 s at 70k-140k unknowns: only where asked
+    if (with_eigen || cfg.all_peers)
+      for (bool g : {false, true}) {
       auto fn = [=](benchmark::State& s) {
         if (f == form::complex) bench_eigen<B, cd>(s, get, f, g, tol);
         else bench_eigen<B, double>(s, get, f, g, tol);
@@ -523,7 +527,7 @@ void register_all() {
           register_solve<5>(ga.name(), geta, f, 1, k, km, tol);
   for (int method = 2; method <= 3; ++method)
     register_solve<5>(ga.name(), geta, form::complex, method, 1, krylov_method::gmres, 1e-8);
-  register_peers<5>(ga.name(), geta, {form::complex, form::real2n}, 1e-8, {0, 1, 2});
+  register_peers<5>(ga.name(), geta, {form::complex, form::real2n}, 1e-8, {0, 1, 2}, true);
   register_peers<5>(ga.name(), geta, {form::real2n}, 1e-2, {0, 1});
 
   // second-order (13-point) Jacobian of the same grid: storage at BILU(3) and solves
@@ -595,6 +599,7 @@ int main(int argc, char** argv) {
   for (int i = 0; i < argc; ++i) {
     const std::string a = argv[i];
     if (a == "--large") cfg.large = true;
+    else if (a == "--all-peers") cfg.all_peers = true;
     else if (a.rfind("--write-mtx=", 0) == 0) cfg.write_mtx = a.substr(12);
     else if (a.rfind("--load-mtx=", 0) == 0) cfg.load_mtx = a.substr(11);
     else if (a.rfind("--mtx-block=", 0) == 0) cfg.mtx_block = std::stoi(a.substr(12));

@@ -7,7 +7,7 @@ preconditioner-storage table of spec 08 (non-zero blocks per method, form and fi
 
 Usage (from the repository root, after building bench_linear_solver):
     bench/run_linear_solver.py [--build-dir build/<name>] [--large] [--filter REGEX]
-                               [--json existing.json]   # re-summarise a previous run
+                               [--all-peers] [--json existing.json]   # re-summarise a previous run
 Benchmark names are kind/matrix/block/scalar/method/fill/solver (see bench_linear_solver.cpp).
 CSV columns: matrix,block,scalar,method,fill,solver,iterations,setup_seconds,solve_seconds,
 preconditioner_blocks,gbytes_per_second.  For kernels (spmv, bilu_*, stream) solve_seconds is
@@ -26,11 +26,13 @@ HEADER = ["matrix", "block", "scalar", "method", "fill", "solver", "iterations",
 UNIT = {"ns": 1e-9, "us": 1e-6, "ms": 1e-3, "s": 1.0}
 
 
-def run_bench(exe, large, flt, json_path):
+def run_bench(exe, large, flt, json_path, all_peers=False):
     cmd = [exe, "--benchmark_format=console", "--benchmark_out_format=json",
            "--benchmark_out=" + json_path]
     if large:
         cmd.append("--large")
+    if all_peers:
+        cmd.append("--all-peers")
     if flt:
         cmd.append("--benchmark_filter=" + flt)
     print("running:", " ".join(cmd), flush=True)
@@ -157,6 +159,7 @@ def main():
     ap.add_argument("--build-dir", default="build/linalg")
     ap.add_argument("--large", action="store_true", help="add the 1M-cell cases (needs ~10 GB)")
     ap.add_argument("--filter", default="")
+    ap.add_argument("--all-peers", action="store_true", help="Eigen IncompleteLUT peers on every matrix (slow)")
     ap.add_argument("--json", default="", help="summarise an existing JSON output instead of running")
     ap.add_argument("--out", default="out/bench/linear_solver.csv")
     args = ap.parse_args()
@@ -166,7 +169,7 @@ def main():
         exe = os.path.join(args.build_dir, "bench", "bench_linear_solver")
         if not os.path.exists(exe):
             sys.exit("no %s: build the target bench_linear_solver first" % exe)
-        run_bench(exe, args.large, args.filter, json_path)
+        run_bench(exe, args.large, args.filter, json_path, args.all_peers)
     rows = rows_from_json(json_path)
     with open(args.out, "w", newline="") as f:
         w = csv.writer(f)
