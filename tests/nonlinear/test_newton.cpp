@@ -51,7 +51,9 @@ TEST(newton, QuadraticConvergenceOnClosedForm) {
   const auto& h = r.report.residual_history;
   ASSERT_GE(h.size(), 4u);
   for (size_t k = 1; k + 1 < h.size(); ++k) {
-    if (h[k] < 1e-2 && h[k + 1] > 1e-14) EXPECT_LT(h[k + 1] / (h[k] * h[k]), 10.0);
+    if (h[k] < 1e-2 && h[k + 1] > 1e-14) {
+      EXPECT_LT(h[k + 1] / (h[k] * h[k]), 10.0);
+    }
   }
 }
 
