@@ -1,0 +1,90 @@
+// Time-marching check of the light-case flutter point (mu_s = 10, M = 0.5, very coarse grid):
+// BDF2 runs of the coupled system at Ubar* -/+ 0.05, started on the critical eigenvector at
+// that Ubar (inverse power), decay
+// and grow, and the growth rate measured from the pitch peaks agrees with the real part of
+// the critical eigenvalue of the dense spectrum at the same Ubar. This checks the coupled
+// residual as an ODE (time scales of flow and structure consistent) independently of the
+// Jacobian-based Hopf solver. Slow: labelled long.
+#include <gtest/gtest.h>
+
+#include <aerohopf/bifurcation/hopf.hpp>
+#include <aerohopf/flow/naca_cgrid.hpp>
+#include <aerohopf/flow/steady_solver.hpp>
+#include <aerohopf/models/aerofoil.hpp>
+#include <aerohopf/time/bdf2.hpp>
+
+#include <Eigen/Eigenvalues>
+
+#include <cmath>
+#include <complex>
+#include <iostream>
+#include <vector>
+
+using namespace aerohopf;
+using namespace aerohopf::flow;
+using models::aerofoil_system;
+
+namespace {
+std::complex<double> eigenvalue_near(const aerofoil_system& s, const vec<double>& w, double ubar, double omega) {
+  Eigen::EigenSolver<Eigen::MatrixXd> es(Eigen::MatrixXd(s.jacobian(w, ubar)), false);
+  std::complex<double> best = es.eigenvalues()[0];
+  for (const auto& l : es.eigenvalues())
+    if (std::abs(l - std::complex<double>(0, omega)) < std::abs(best - std::complex<double>(0, omega))) best = l;
+  return best;
+}
+
+// Least-squares slope of log |peak| against time over the local maxima of |alpha| after t_skip.
+double peak_growth_rate(const std::vector<double>& t, const std::vector<double>& a, double t_skip) {
+  double sx = 0, sy = 0, sxx = 0, sxy = 0;
+  int n = 0;
+  for (std::size_t k = 1; k + 1 < a.size(); ++k) {
+    if (t[k] < t_skip) continue;
+    const double y = std::abs(a[k]);
+    if (y > std::abs(a[k - 1]) && y >= std::abs(a[k + 1])) {
+      const double ly = std::log(y);
+      sx += t[k];
+      sy += ly;
+      sxx += t[k] * t[k];
+      sxy += t[k] * ly;
+      ++n;
+    }
+  }
+  EXPECT_GE(n, 4);
+  return (n * sxy - sx * sy) / (n * sxx - sx * sx);
+}
+}  // namespace
+
+TEST(aerofoil_time_long, growth_rates_straddling_the_flutter_point_match_dense_spectrum) {
+  structure::pitch_plunge_parameters p;
+  p.mu_s = 10;
+  const aerofoil_system s(euler_model<2>(coarsen(naca_cgrid(), 8), {.mach = 0.5, .alpha_rad = 0.0}),
+                          structure::pitch_plunge(p));
+  euler_model<2> flow = s.flow();
+  vec<double> wf = flow.free_stream_vector();
+  ASSERT_TRUE(solve_steady<2>(flow, wf).converged);
+  vec<double> w = s.free_stream_state();
+  w.head(s.flow_size()) = wf;
+  hopf_options hopt;
+  hopt.symmetric = true;
+  const hopf_result h = solve_hopf(s, hopf_start(s, w, 1.75, 0.6), hopt);
+  const double ubar = h.point.mu, omega = h.point.omega;
+  bdf2_options opt;
+  opt.dt = 0.2;  // ~ 40 steps per cycle
+  opt.inner_tolerance = 1e-9;
+  for (double du : {-0.05, 0.05}) {
+    // initial state on the critical mode at this Ubar (inverse power), pitch amplitude 1e-3 rad
+    const vec<std::complex<double>> pv = hopf_start(s, w, ubar + du, omega).p;
+    const vec<double> w0 = w + 1e-3 * pv.real() / std::abs(pv[s.size() - 2]);
+    std::vector<double> t, alpha;
+    integrate_bdf2(s, ubar + du, w0, 0.0, 4 * 2 * M_PI / omega, opt, [&](const bdf2_step_info& info, const vec<double>& y) {
+      t.push_back(info.t);
+      alpha.push_back(y[s.size() - 2]);
+    });
+    const double rate = peak_growth_rate(t, alpha, 2 * M_PI / omega);
+    const auto lambda = eigenvalue_near(s, w, ubar + du, omega);
+    std::cout << "Ubar* " << (du < 0 ? "- " : "+ ") << std::abs(du) << ": time-marching growth rate " << rate
+              << ", dense eigenvalue " << lambda << "\n";
+    EXPECT_EQ(rate > 0, du > 0);
+    EXPECT_NEAR(rate, lambda.real(), 0.15 * std::abs(lambda.real()));
+  }
+}
