@@ -40,11 +40,7 @@ TEST(aerofoil_hopf_long, heavy_case_flutter_bracket_and_hopf_point) {
   p.mu_s = 100;
   const aerofoil_system s(euler_model<2>(coarsen(naca_cgrid(), 8), {.mach = 0.5, .alpha_rad = 0.0}),
                           structure::pitch_plunge(p));
-  euler_model<2> flow = s.flow();
-  vec<double> wf = flow.free_stream_vector();
-  ASSERT_TRUE(solve_steady<2>(flow, wf).converged);
-  vec<double> w = s.free_stream_state();
-  w.head(s.flow_size()) = wf;
+  const vec<double> w = s.steady_equilibrium();
 
   double lo = -1, hi = -1, omega_guess = 0;
   double prev_u = 0;

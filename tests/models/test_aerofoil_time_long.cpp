@@ -59,11 +59,7 @@ TEST(aerofoil_time_long, growth_rates_straddling_the_flutter_point_match_dense_s
   p.mu_s = 10;
   const aerofoil_system s(euler_model<2>(coarsen(naca_cgrid(), 8), {.mach = 0.5, .alpha_rad = 0.0}),
                           structure::pitch_plunge(p));
-  euler_model<2> flow = s.flow();
-  vec<double> wf = flow.free_stream_vector();
-  ASSERT_TRUE(solve_steady<2>(flow, wf).converged);
-  vec<double> w = s.free_stream_state();
-  w.head(s.flow_size()) = wf;
+  const vec<double> w = s.steady_equilibrium();
   hopf_options hopt;
   hopt.symmetric = true;
   const hopf_result h = solve_hopf(s, hopf_start(s, w, 1.75, 0.6), hopt);

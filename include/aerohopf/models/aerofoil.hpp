@@ -35,6 +35,7 @@
 #include "../flow/euler_model.hpp"
 #include "../flow/jacobian.hpp"
 #include "../flow/metrics.hpp"
+#include "../flow/steady_solver.hpp"
 #include "../linalg/direct.hpp"
 #include "../nonlinear/system.hpp"
 #include "../scalar/taylor.hpp"
@@ -85,11 +86,23 @@ class aerofoil_system {
   const flow::euler_model<2>& flow() const { return flow_; }
   const structure::pitch_plunge& structure() const { return structure_; }
 
-  /// Uniform free stream with the section at rest: the equilibrium of a symmetric aerofoil at
-  /// zero incidence for every Ubar.
+  /// Uniform free stream with the section at rest (the start of the steady solve).
   vec<double> free_stream_state() const {
     vec<double> w = vec<double>::Zero(size());
     w.head(nf_) = flow_.free_stream_vector();
+    return w;
+  }
+
+  /// The equilibrium with the section at rest: steady flow (solve_steady from the free stream)
+  /// and zero structural state. For a symmetric aerofoil at zero incidence it is the same for
+  /// every Ubar. solve_steady throws convergence_error if the steady solve fails.
+  vec<double> steady_equilibrium(const flow::steady_options& opt = {}) const {
+    flow::euler_model<2> f = flow_;
+    vec<double> wf = f.free_stream_vector();
+    const auto report = flow::solve_steady<2>(f, wf, opt);
+    if (!report.converged) throw convergence_error("aerofoil_system::steady_equilibrium: steady solve did not converge");
+    vec<double> w = free_stream_state();
+    w.head(nf_) = wf;
     return w;
   }
 
