@@ -8,6 +8,7 @@
 #include <cmath>
 
 #include "aerohopf/models/hopf_normal_form.hpp"
+#include "aerohopf/linalg/krylov_solver.hpp"
 #include "aerohopf/time.hpp"
 
 using namespace aerohopf;
@@ -118,6 +119,42 @@ TEST(Bdf2, DualTimeConvergesToSameSolution) {
   });
   EXPECT_LT((wn - wd).norm(), 1e-9);
   EXPECT_GT(dual_iters, 3);  // pseudo-time iterations converge linearly
+}
+
+// CFD-style inner iterations: matrix formed and factored once per physical step (a chord
+// iteration), solved by BILU-GMRES (krylov_solver), stopped by a residual drop. The frozen
+// matrix converges linearly, so it takes more inner iterations, but to the same solution: the
+// inner residual drop bounds the difference to the fully converged Newton run.
+TEST(Bdf2, FrozenMatrixKrylovAndResidualDropReachTheNewtonSolution) {
+  const hopf_normal_form m(1.0, 3, 5);
+  const sparse_normal_form sm{m};
+  const double mu = 0.05;
+  const vec<double> w0 = 0.3 * m.basis().col(1) + 0.1 * m.basis().col(3);
+  const bdf2_options newton{.dt = 0.01};
+  bdf2_options chord{.dt = 0.01, .max_inner_iterations = 60};
+  chord.inner_residual_drop = 1e-8;
+  chord.freeze_matrix = true;
+  chord.approximate_jacobian = true;  // falls back to the exact Jacobian for this system
+  krylov_solver_options ko;
+  ko.krylov.relative_tolerance = 1e-10;
+  krylov_solver<Eigen::SparseMatrix<double>> solver(ko);
+  int max_chord = 0;
+  const vec<double> wn = integrate_bdf2(sm, mu, w0, 0.0, 3.0, newton);
+  const vec<double> wc = integrate_bdf2(
+      sm, mu, w0, 0.0, 3.0, chord,
+      [&](const bdf2_step_info& i, const vec<double>&) { max_chord = std::max(max_chord, i.inner_iterations); }, solver);
+  EXPECT_LT((wn - wc).norm(), 1e-7 * wn.norm());
+  EXPECT_GE(max_chord, 2);
+  // a residual drop that cannot be met in the allowed iterations is reported, with the step
+  bdf2_options tight = chord;
+  tight.inner_residual_drop = 1e-300;
+  tight.inner_tolerance = 1e-300;
+  tight.max_inner_iterations = 2;
+  EXPECT_THROW(integrate_bdf2(sm, mu, w0, 0.0, 0.1, tight, [](const bdf2_step_info&, const vec<double>&) {}, solver),
+               convergence_error);
+  bdf2_options bad = chord;
+  bad.inner_residual_drop = 1.5;
+  EXPECT_THROW(integrate_bdf2(sm, mu, w0, 0.0, 0.1, bad), input_error);
 }
 
 TEST(Bdf2, HistoryAndErrors) {

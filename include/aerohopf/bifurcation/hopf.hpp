@@ -63,6 +63,7 @@ struct hopf_result {
   hopf_point point;      ///< p normalised with s.p_r = 0, s.p_i = 1
   vec<double> s;         ///< the normalisation vector used
   newton_report report;  ///< per-iteration residuals of the augmented system
+  long linear_iterations = 0;  ///< Krylov iterations over all solves (0 for direct solvers)
 };
 
 /// Rotates the phase of p and scales it so that s.p_r = 0 and s.p_i = 1 for the returned s

@@ -106,6 +106,19 @@ class aerofoil_system {
     return w;
   }
 
+  /// Grid sequencing: a state or eigenvector v of `coarse`, whose flow grid is this system's grid
+  /// coarsened by m, transferred to this system (flow by injection, structural part copied).
+  template <class T>
+  vec<T> prolong_from(const aerofoil_system& coarse, int m, const vec<T>& v) const {
+    require(v.size() == coarse.size(), "aerofoil_system::prolong_from: vector has ", v.size(), " entries, coarse system ",
+            coarse.size());
+    vec<T> out(size());
+    out.head(nf_) = flow::prolong_cells<2>(coarse.flow().grid().topology, flow_.grid().topology, m,
+                                           vec<T>(v.head(coarse.flow_size())), nv);
+    out.tail(n_structure) = v.tail(n_structure);
+    return out;
+  }
+
   template <class T>
   coupling::rigid_pose<T> pose(const vec<T>& w) const {
     return {w[nf_], w[nf_ + 1], w[nf_ + 2], w[nf_ + 3]};

@@ -16,8 +16,15 @@
 // linear instead of quadratic inner convergence). pseudo_dt = 0 is plain Newton.
 //
 // Inner convergence: ||dw||_inf <= inner_tolerance * (1 + ||w||_inf) (in dual time also
-// ||R||_inf / c below the same bound). If it is not reached in
-// max_inner_iterations, convergence_error names the time step, time, iterations and residual.
+// ||R||_inf / c below the same bound), or, with inner_residual_drop > 0, ||R||_inf dropped by
+// that factor from its value at the first inner iterate of the step (the CFD practice: "three
+// orders per real step"). If neither is reached in max_inner_iterations, convergence_error
+// names the time step, time, iterations and residual.
+//
+// CFD-sized systems: the inner matrix may be the system's approximate (modified-order)
+// Jacobian (approximate_jacobian) and may be formed and factored once per physical step
+// (freeze_matrix: a chord / dual-time iteration); the linear solver is a template argument with
+// the compute/solve interface (direct_solver by default, krylov_solver for BILU + GMRES).
 #include <Eigen/Core>
 
 #include <cmath>
@@ -36,6 +43,9 @@ struct bdf2_options {
   double inner_tolerance = 1e-10;  ///< on ||dw||_inf / (1 + ||w||_inf)
   int max_inner_iterations = 20;
   double pseudo_dt = 0;            ///< > 0: dual-time inner iterations with this pseudo step
+  double inner_residual_drop = 0;  ///< > 0: also converged once ||R||_inf <= this x its first value
+  bool approximate_jacobian = false;  ///< inner matrix from lhs_jacobian (e.g. modified order)
+  bool freeze_matrix = false;      ///< form and factor the inner matrix once per physical step
 };
 
 /// What the observer sees after each physical step.
@@ -47,10 +57,11 @@ struct bdf2_step_info {
 };
 
 /// Integrates from w0 at t0 to t_end; calls observer(const bdf2_step_info&, const vec<double>& w)
-/// at the start and after every step; returns w(t_end).
-template <dynamical_system S, class Observer>
+/// at the start and after every step; returns w(t_end). solver: compute(matrix)/solve(vector)
+/// for the inner matrix (c + 1/pseudo_dt) I - A.
+template <dynamical_system S, class Observer, class Solver>
 vec<double> integrate_bdf2(const S& s, double mu, vec<double> w0, double t0, double t_end, const bdf2_options& opt,
-                           Observer&& observer) {
+                           Observer&& observer, Solver& solver) {
   const char* who = "integrate_bdf2";
   check_state(s, w0, mu, who);
   const long steps = internal::step_count(t0, t_end, opt.dt, who);
@@ -58,10 +69,11 @@ vec<double> integrate_bdf2(const S& s, double mu, vec<double> w0, double t0, dou
           ": inner_tolerance must be positive (got ", opt.inner_tolerance, ")");
   require(opt.max_inner_iterations >= 1, who, ": max_inner_iterations must be >= 1 (got ", opt.max_inner_iterations, ")");
   require(std::isfinite(opt.pseudo_dt) && opt.pseudo_dt >= 0, who, ": pseudo_dt must be >= 0 (got ", opt.pseudo_dt, ")");
+  require(std::isfinite(opt.inner_residual_drop) && opt.inner_residual_drop >= 0 && opt.inner_residual_drop < 1, who,
+          ": inner_residual_drop must be in [0, 1) (got ", opt.inner_residual_drop, ")");
   const double h = steps > 0 ? (t_end - t0) / double(steps) : 0.0;
 
   using matrix = jacobian_t<S>;
-  direct_solver<matrix> solver(std::string(who) + ": inner Newton matrix");
   vec<double> w_prev = w0, w = std::move(w0);
   bdf2_step_info info;
   info.t = t0;
@@ -75,16 +87,23 @@ vec<double> integrate_bdf2(const S& s, double mu, vec<double> w0, double t0, dou
     const vec<double> hist = first ? vec<double>(w / h) : vec<double>((4.0 * w - w_prev) / (2.0 * h));
     vec<double> x = first ? w : vec<double>(2.0 * w - w_prev);  // linear extrapolation as guess
     bool converged = false;
-    double rnorm = 0, dnorm = 0;
+    double rnorm = 0, dnorm = 0, r0 = 0;
     int it = 0;
     while (it < opt.max_inner_iterations) {
-      ++it;
       const vec<double> r = c * x - hist - s.residual(x, mu);
       rnorm = r.template lpNorm<Eigen::Infinity>();
       if (!std::isfinite(rnorm)) break;
-      const matrix a = s.jacobian(x, mu);
-      const matrix lhs = matrix(identity_like<double>(a) * shift) - a;
-      solver.compute(lhs);
+      if (it == 0) r0 = rnorm;
+      if (it > 0 && opt.inner_residual_drop > 0 && rnorm <= opt.inner_residual_drop * r0) {
+        converged = true;
+        break;
+      }
+      ++it;
+      if (it == 1 || !opt.freeze_matrix) {
+        const matrix a = opt.approximate_jacobian ? lhs_jacobian(s, x, mu) : matrix(s.jacobian(x, mu));
+        const matrix lhs = matrix(identity_like<double>(a) * shift) - a;
+        solver.compute(lhs);
+      }
       const vec<double> dx = solver.solve(vec<double>(-r));
       x += dx;
       dnorm = dx.template lpNorm<Eigen::Infinity>();
@@ -110,6 +129,14 @@ vec<double> integrate_bdf2(const S& s, double mu, vec<double> w0, double t0, dou
     observer(static_cast<const bdf2_step_info&>(info), static_cast<const vec<double>&>(w));
   }
   return w;
+}
+
+/// Same with the direct solver of the system's matrix type.
+template <dynamical_system S, class Observer>
+vec<double> integrate_bdf2(const S& s, double mu, vec<double> w0, double t0, double t_end, const bdf2_options& opt,
+                           Observer&& observer) {
+  direct_solver<jacobian_t<S>> solver("integrate_bdf2: inner Newton matrix");
+  return integrate_bdf2(s, mu, std::move(w0), t0, t_end, opt, std::forward<Observer>(observer), solver);
 }
 
 template <dynamical_system S>

@@ -1,0 +1,629 @@
+// Flutter of the pitch-plunge NACA 0012 (spec 05): direct Hopf-point stability boundaries
+// Ubar(M), their verification by dense spectra and by time marching, and the centre-manifold
+// reduced model at a transonic Mach number of the heavy case.
+//
+// Usage: aerofoil_flutter [out_dir] [options]
+//   --case light|heavy|both     structural case (mu_s = 10 / 100), default both
+//   --grids coarse,medium       grid levels of the boundaries (very_coarse, coarse, medium, fine)
+//   --mach-min M --mach-max M   Mach range (default 0.5 .. 0.95; steps 0.05, and 0.01 from 0.80)
+//   --mach-step d               one uniform step instead of the default list
+//   --method natural|arclength  boundary by natural continuation in M (previous point as the
+//                               start, secant predictor, step halving on failure) or by
+//                               pseudo-arclength continuation of the Hopf curve in (M, Ubar)
+//   --fill k                    BILU(k) of the Hopf preconditioner (default 1)
+//   --skip-spectra --skip-boundaries --skip-verify --skip-reduced    parts to leave out
+//   --verify-grid g             grid of the time-marching verification (default medium)
+//   --quick                     coarse grid, M = 0.5 .. 0.8 step 0.1, shorter time marching
+//
+// Outputs under out_dir (default out/aerofoil_flutter):
+//   flutter_point_very_coarse.txt, spectra.csv (ubar,re,im)     very coarse, light, M = 0.5
+//   boundary_<case>_<grid>.csv  mach,ubar,omega,newton_iterations,linear_iterations,hopf_seconds,steady_seconds
+//   verification.csv, history_<case>_M<mach>_<factor>.csv       time marching at 0.97 / 1.03 Ubar*
+//   costs.csv                                                   cost ratios to the steady solve
+//   reduced_coefficients.csv, reduced_damping.csv, reduced_lco.csv   reduced model (heavy case)
+// plot.py in this folder turns them into PNGs.
+#include <aerohopf/bifurcation/hopf.hpp>
+#include <aerohopf/bifurcation/hopf_bordered.hpp>
+#include <aerohopf/bifurcation/inverse_power.hpp>
+#include <aerohopf/flow/naca_cgrid.hpp>
+#include <aerohopf/flow/steady_solver.hpp>
+#include <aerohopf/io/csv.hpp>
+#include <aerohopf/linalg/krylov_solver.hpp>
+#include <aerohopf/models/aerofoil.hpp>
+#include <aerohopf/reduction.hpp>
+#include <aerohopf/scalar/qd.hpp>
+#include <aerohopf/time/bdf2.hpp>
+
+#include <Eigen/Eigenvalues>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <iomanip>
+#include <iostream>
+#include <map>
+#include <numbers>
+#include <optional>
+#include <sstream>
+#include <string>
+#include <vector>
+
+using namespace aerohopf;
+using namespace aerohopf::flow;
+using models::aerofoil_system;
+using clk = std::chrono::steady_clock;
+using cplx = std::complex<double>;
+
+namespace {
+
+double seconds_since(clk::time_point t0) { return std::chrono::duration<double>(clk::now() - t0).count(); }
+
+struct grid_level {
+  std::string name;
+  int stride;  // every stride-th point of the fine grid
+};
+
+grid_level level_named(const std::string& name) {
+  if (name == "very_coarse") return {name, 8};
+  if (name == "coarse") return {name, 4};
+  if (name == "medium") return {name, 2};
+  if (name == "fine") return {name, 1};
+  throw input_error("unknown grid level '" + name + "' (very_coarse, coarse, medium, fine)");
+}
+
+struct structural_case {
+  std::string name;
+  double mu_s;
+  double ubar_guess, omega_guess;  // start of the first inverse power (very coarse M = 0.5 values)
+};
+
+const structural_case light_case{"light", 10.0, 1.66, 0.75};
+const structural_case heavy_case{"heavy", 100.0, 4.6, 0.22};
+
+const multiblock_grid<2>& fine_grid() {
+  static const multiblock_grid<2> g = naca_cgrid();
+  return g;
+}
+
+aerofoil_system make_system(const grid_level& g, double mach, double mu_s) {
+  structure::pitch_plunge_parameters p;
+  p.mu_s = mu_s;
+  return aerofoil_system(euler_model<2>(coarsen(fine_grid(), g.stride), {.mach = mach, .alpha_rad = 0.0}),
+                         structure::pitch_plunge(p));
+}
+
+std::string fixed(double x, int digits) {
+  std::ostringstream os;
+  os << std::fixed << std::setprecision(digits) << x;
+  return os.str();
+}
+
+/// Steady equilibrium from the free stream, timed (the unit of cost of the whole method).
+struct steady_result {
+  vec<double> w;
+  double seconds = 0;
+  int steps = 0;
+};
+steady_result steady(const aerofoil_system& s) {
+  const auto t0 = clk::now();
+  steady_options so;
+  steady_result r;
+  r.w = s.steady_equilibrium(so);
+  r.seconds = seconds_since(t0);
+  return r;
+}
+
+struct options {
+  std::filesystem::path out = "out/aerofoil_flutter";
+  std::vector<structural_case> cases{light_case, heavy_case};
+  std::vector<grid_level> grids{level_named("coarse"), level_named("medium")};
+  double mach_min = 0.5, mach_max = 0.95, mach_step = 0;
+  std::string method = "natural";
+  int fill = 1;
+  bool spectra = true, boundaries = true, verify = true, reduced = true, quick = false;
+  grid_level verify_grid = level_named("medium");
+};
+
+std::vector<double> mach_list(const options& o) {
+  std::vector<double> m;
+  if (o.mach_step > 0) {
+    for (int k = 0;; ++k) {
+      const double x = o.mach_min + k * o.mach_step;
+      if (x > o.mach_max + 1e-9) break;
+      m.push_back(std::round(x * 1e4) / 1e4);
+    }
+    return m;
+  }
+  for (int k = 0; k <= 6; ++k) m.push_back(0.5 + 0.05 * k);  // 0.50 .. 0.80
+  for (int k = 1; k <= 15; ++k) m.push_back(0.80 + 0.01 * k);  // 0.81 .. 0.95
+  std::vector<double> r;
+  for (double x : m)
+    if (x >= o.mach_min - 1e-9 && x <= o.mach_max + 1e-9) r.push_back(std::round(x * 1e4) / 1e4);
+  return r;
+}
+
+hopf_options hopf_opts(const std::string& label) {
+  hopf_options ho;
+  ho.symmetric = true;
+  ho.label = label;
+  ho.newton.max_iterations = 20;
+  ho.verbose = std::getenv("AF_VERBOSE") != nullptr;
+  return ho;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Part 1: very coarse grid, light case, M = 0.5: Hopf point and the dense spectra around it.
+
+void spectra_part(const options& o) {
+  std::cout << "\n=== very coarse grid, light case, M = 0.5: flutter point and dense spectra ===\n";
+  const auto s = make_system(level_named("very_coarse"), 0.5, light_case.mu_s);
+  const auto st = steady(s);
+  hopf_options ho = hopf_opts("hopf very coarse");
+  ho.verbose = true;
+  const hopf_result h = solve_hopf_krylov<4>(s, hopf_start(s, st.w, light_case.ubar_guess, light_case.omega_guess), ho);
+  const double ubar = h.point.mu, omega = h.point.omega;
+  std::cout << std::setprecision(10) << "very coarse grid (" << s.flow().n_cells() << " cells), light case, M = 0.5: Ubar* = "
+            << ubar << ", omega* = " << omega << " (" << h.report.iterations << " Newton iterations)\n";
+  {
+    std::ofstream f(o.out / "flutter_point_very_coarse.txt");
+    f << std::setprecision(12) << "ubar_star " << ubar << "\nomega_star " << omega << "\n";
+  }
+  csv_writer csv(o.out / "spectra.csv", "ubar_offset,ubar,re,im");
+  for (double d : {-0.01, 0.0, 0.01}) {
+    Eigen::EigenSolver<Eigen::MatrixXd> es(Eigen::MatrixXd(s.jacobian(st.w, ubar + d)), false);
+    cplx crit = es.eigenvalues()[0];
+    double other = -1e300;
+    for (const auto& l : es.eigenvalues()) {
+      csv.row({d, ubar + d, l.real(), l.imag()});
+      if (std::abs(l - cplx(0, omega)) < std::abs(crit - cplx(0, omega))) crit = l;
+    }
+    for (const auto& l : es.eigenvalues())
+      if (std::abs(l - crit) > 1e-9 && std::abs(l - std::conj(crit)) > 1e-9) other = std::max(other, l.real());
+    std::cout << "  Ubar* " << (d < 0 ? "- 0.01" : d > 0 ? "+ 0.01" : "       ") << ": critical eigenvalue " << crit
+              << ", largest real part of the others " << other << "\n";
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Part 2: stability boundaries Ubar(M) by the direct method.
+
+struct boundary_point {
+  double mach, ubar, omega;
+  int newton_iterations;
+  long linear_iterations;
+  double hopf_seconds, steady_seconds;
+  hopf_point point;  // with the flow state of this Mach number
+};
+
+using boundary = std::vector<boundary_point>;
+
+/// One Hopf point at Mach M from the guess (p, Ubar, omega); steady flow from the free stream.
+std::optional<boundary_point> hopf_at(const aerofoil_system& s, double mach, const steady_result& st,
+                                      const hopf_point& guess, int fill, const std::string& label) {
+  hopf_point g = guess;
+  g.w = st.w;
+  hopf_krylov_options ko;
+  ko.fill_level = fill;
+  const auto t0 = clk::now();
+  try {
+    hopf_result h = solve_hopf_krylov<4>(s, g, hopf_opts(label), ko);
+    // Ubar enters the model only through 1/Ubar^2 (spec 05), so -Ubar* is the same point:
+    // Newton may land on that mirror image; report the physical, positive speed.
+    h.point.mu = std::abs(h.point.mu);
+    return boundary_point{mach, h.point.mu, h.point.omega, h.report.iterations, h.linear_iterations,
+                          seconds_since(t0), st.seconds, h.point};
+  } catch (const error& e) {
+    std::cout << "    " << label << " failed: " << e.what() << "\n";
+    return std::nullopt;
+  }
+}
+
+/// Natural continuation in M: each point starts from the previous one (Ubar, omega by secant
+/// extrapolation over the last two points, p as it is); a failed point is retried from half the
+/// Mach step (down to 1/8), the intermediate converged points are kept in the boundary.
+boundary natural_boundary(const structural_case& c, const grid_level& g, const std::vector<double>& machs,
+                          const boundary* coarser, int coarser_ratio, int fill, csv_writer& csv) {
+  boundary b;
+  auto write = [&](const boundary_point& p) {
+    b.push_back(p);
+    csv.row({p.mach, p.ubar, p.omega, static_cast<long long>(p.newton_iterations),
+             static_cast<long long>(p.linear_iterations), p.hopf_seconds, p.steady_seconds});
+    std::printf("  %-6s %-8s M = %.4f  Ubar* = %.6f  omega* = %.6f  Newton %d  GMRES %5ld  hopf %.2f s  steady %.2f s  (ratio %.2f)\n",
+                c.name.c_str(), g.name.c_str(), p.mach, p.ubar, p.omega, p.newton_iterations, p.linear_iterations,
+                p.hopf_seconds, p.steady_seconds, p.hopf_seconds / p.steady_seconds);
+    std::fflush(stdout);
+  };
+  for (double mach : machs) {
+    double m_done = b.empty() ? mach : b.back().mach;
+    double step = mach - m_done;
+    while (b.empty() || b.back().mach < mach - 1e-9) {
+      const double m = b.empty() ? mach : std::min(mach, b.back().mach + step);
+      const auto s = make_system(g, m, c.mu_s);
+      const auto st = steady(s);
+      hopf_point guess;
+      const std::string label = c.name + " " + g.name + " M=" + fixed(m, 4);
+      const auto t0 = clk::now();
+      if (!b.empty()) {
+        guess = b.back().point;
+        if (b.size() >= 2) {  // secant predictor in M for Ubar and omega
+          const auto& p1 = b[b.size() - 2];
+          const auto& p2 = b.back();
+          const double t = (m - p2.mach) / (p2.mach - p1.mach);
+          guess.mu = p2.ubar + t * (p2.ubar - p1.ubar);
+          guess.omega = p2.omega + t * (p2.omega - p1.omega);
+        }
+      } else if (coarser) {  // grid sequencing from the coarser boundary at this Mach number
+        const auto it = std::find_if(coarser->begin(), coarser->end(),
+                                     [&](const boundary_point& p) { return std::abs(p.mach - m) < 1e-9; });
+        require(it != coarser->end(), "no coarse-grid point at M = ", m, " to start the finer grid from");
+        const auto sc = make_system(level_named(g.name == "medium" ? "coarse" : "very_coarse"), m, c.mu_s);
+        guess = it->point;
+        guess.p = s.prolong_from<cplx>(sc, coarser_ratio, it->point.p);
+      } else {
+        guess = hopf_start(s, st.w, c.ubar_guess, c.omega_guess);
+        guess.mu = c.ubar_guess;
+      }
+      const double start_seconds = seconds_since(t0);
+      auto p = hopf_at(s, m, st, guess, fill, label);
+      if (p) {
+        p->hopf_seconds += start_seconds;
+        write(*p);
+        step = std::max(step, 1e-9);
+        continue;
+      }
+      if (b.empty())
+        throw convergence_error(aerohopf::internal::concat("boundary ", c.name, " ", g.name,
+                                                           ": no Hopf point at the first Mach number ", m));
+      if (step < (mach - m_done) / 8.0 + 1e-12) {
+        std::cout << "    " << label << ": no convergence from M = " << b.back().mach
+                  << " even with 1/8 of the Mach step: the boundary is not continued past M = " << b.back().mach
+                  << " by natural continuation\n";
+        return b;
+      }
+      step *= 0.5;
+      std::cout << "    retrying with Mach step " << step << "\n";
+    }
+  }
+  return b;
+}
+
+std::map<std::string, boundary> boundaries_part(const options& o) {
+  std::map<std::string, boundary> all;
+  const auto machs = mach_list(o);
+  for (const auto& c : o.cases) {
+    const boundary* coarser = nullptr;
+    std::string coarser_name;
+    for (const auto& g : o.grids) {
+      std::cout << "\n=== stability boundary: " << c.name << " case (mu_s = " << c.mu_s << "), " << g.name
+                << " grid, " << machs.size() << " Mach numbers, method " << o.method << " ===\n";
+      csv_writer csv(o.out / ("boundary_" + c.name + "_" + g.name + ".csv"),
+                     "mach,ubar,omega,newton_iterations,linear_iterations,hopf_seconds,steady_seconds");
+      const int ratio = coarser ? level_named(coarser_name).stride / g.stride : 0;
+      const auto t0 = clk::now();
+      boundary b = natural_boundary(c, g, machs, ratio == 2 ? coarser : nullptr, ratio, o.fill, csv);
+      double hopf = 0, steady_total = 0;
+      for (const auto& p : b) {
+        hopf += p.hopf_seconds;
+        steady_total += p.steady_seconds;
+      }
+      std::printf("  %s %s: %zu points in %.1f s (Hopf %.1f s + steady %.1f s); Hopf / steady = %.2f\n", c.name.c_str(),
+                  g.name.c_str(), b.size(), seconds_since(t0), hopf, steady_total, hopf / steady_total);
+      all[c.name + "_" + g.name] = b;
+      coarser = &all[c.name + "_" + g.name];
+      coarser_name = g.name;
+    }
+  }
+  return all;
+}
+
+
+// ---------------------------------------------------------------------------------------------
+// Part 3: time marching at 0.97 and 1.03 Ubar* (implicit BDF2, dual time, dt = 0.125).
+
+/// Least-squares slope of log |peak| against time over the local maxima of |y| after t_skip.
+double peak_growth_rate(const std::vector<double>& t, const std::vector<double>& y, double t_skip, int* peaks) {
+  double sx = 0, sy = 0, sxx = 0, sxy = 0;
+  int n = 0;
+  for (std::size_t k = 1; k + 1 < y.size(); ++k) {
+    if (t[k] < t_skip) continue;
+    const double a = std::abs(y[k]);
+    if (a > std::abs(y[k - 1]) && a >= std::abs(y[k + 1])) {
+      const double l = std::log(a);
+      sx += t[k];
+      sy += l;
+      sxx += t[k] * t[k];
+      sxy += t[k] * l;
+      ++n;
+    }
+  }
+  if (peaks) *peaks = n;
+  return n >= 2 ? (n * sxy - sx * sy) / (n * sxx - sx * sx) : NAN;
+}
+
+struct march_result {
+  double ubar = 0, growth_rate = 0, re_lambda = 0, im_lambda = 0, seconds = 0, steady_seconds = 0;
+  long steps = 0, inner_iterations = 0;
+  int peaks = 0;
+};
+
+/// BDF2 run of the coupled system at Ubar = factor Ubar*, started on the critical eigenvector
+/// at that Ubar (pitch amplitude 0.01 rad), compared with the real part of that eigenvalue.
+march_result time_march(const structural_case& c, const grid_level& g, const boundary_point& bp, double factor,
+                        double cycles, const options& o) {
+  march_result r;
+  const auto s = make_system(g, bp.mach, c.mu_s);
+  const auto st = steady(s);
+  r.steady_seconds = st.seconds;
+  r.ubar = factor * bp.ubar;
+  // the critical eigenpair at this Ubar (shift-invert from the Hopf eigenvalue)
+  vec<cplx> p0 = bp.point.p.size() == s.size() ? bp.point.p : vec<cplx>();
+  const eigen_pair ep = inverse_power(s.jacobian(st.w, r.ubar), cplx(0.0, bp.omega), {}, p0.size() ? &p0 : nullptr);
+  r.re_lambda = ep.lambda.real();
+  r.im_lambda = std::abs(ep.lambda.imag());
+  vec<cplx> v = ep.vector;
+  const Eigen::Index ia = s.flow_size() + 2;
+  v *= 0.01 / v[ia];  // pitch component real, 0.01 rad
+  vec<double> w0 = st.w + v.real();
+
+  bdf2_options bo;
+  bo.dt = 0.125;
+  bo.inner_residual_drop = 1e-3;  // three orders per real time step
+  bo.approximate_jacobian = true;  // modified-order Jacobian, frozen over the step (dual time)
+  bo.freeze_matrix = true;
+  bo.max_inner_iterations = 40;
+  krylov_solver_options ko;
+  ko.fill_level = 0;
+  ko.krylov.relative_tolerance = 1e-2;
+  ko.krylov.max_iterations = 400;
+  ko.krylov.record_history = false;
+  krylov_solver<Eigen::SparseMatrix<double>, 4> solver(ko, "BDF2 inner BILU(0)-GMRES");
+  const double t_end = cycles * 2 * std::numbers::pi / bp.omega;
+  std::vector<double> t, alpha, h;
+  const std::string tag = c.name + "_" + g.name + "_M" + fixed(bp.mach, 2) + "_" + fixed(factor, 2);
+  csv_writer csv(o.out / ("history_" + tag + ".csv"), "t,h,alpha");
+  const auto t0 = clk::now();
+  integrate_bdf2(
+      s, r.ubar, w0, 0.0, t_end, bo,
+      [&](const bdf2_step_info& i, const vec<double>& w) {
+        t.push_back(i.t);
+        h.push_back(w[s.flow_size()]);
+        alpha.push_back(w[ia]);
+        csv.row({i.t, h.back(), alpha.back()});
+        r.steps = i.step;
+        r.inner_iterations += i.inner_iterations;
+        if (i.step > 0 && i.step % 100 == 0)
+          std::printf("    %s: step %ld  t = %.2f  alpha = %+.5e  inner iterations %d\n", tag.c_str(), i.step, i.t,
+                      alpha.back(), i.inner_iterations);
+      },
+      solver);
+  r.seconds = seconds_since(t0);
+  r.growth_rate = peak_growth_rate(t, alpha, 2 * std::numbers::pi / bp.omega, &r.peaks);
+  return r;
+}
+
+void verification_part(const options& o, const std::map<std::string, boundary>& all, std::vector<double>& march_costs) {
+  const structural_case& c = light_case;
+  const auto it = all.find(c.name + "_" + o.verify_grid.name);
+  if (it == all.end()) {
+    std::cout << "\n(time-marching verification skipped: no " << c.name << " boundary on the " << o.verify_grid.name
+              << " grid in this run)\n";
+    return;
+  }
+  std::cout << "\n=== time marching (BDF2, dt = 0.125, 3 orders per step) at 0.97 / 1.03 Ubar*, " << c.name << " case, "
+            << o.verify_grid.name << " grid ===\n";
+  csv_writer csv(o.out / "verification.csv",
+                 "case,grid,mach,ubar_star,factor,ubar,growth_rate,re_lambda,im_lambda,steps,inner_iterations,march_seconds,"
+                 "steady_seconds");
+  const std::vector<double> machs = o.quick ? std::vector<double>{0.5} : std::vector<double>{0.5, 0.8, 0.85};
+  for (double m : machs) {
+    const auto p = std::find_if(it->second.begin(), it->second.end(),
+                                [&](const boundary_point& q) { return std::abs(q.mach - m) < 1e-9; });
+    if (p == it->second.end()) {
+      std::cout << "  no boundary point at M = " << m << "\n";
+      continue;
+    }
+    for (double f : {0.97, 1.03}) {
+      const march_result r = time_march(c, o.verify_grid, *p, f, o.quick ? 3.0 : 4.0, o);
+      csv.row({c.name, o.verify_grid.name, m, p->ubar, f, r.ubar, r.growth_rate, r.re_lambda, r.im_lambda,
+               static_cast<long long>(r.steps), static_cast<long long>(r.inner_iterations), r.seconds, r.steady_seconds});
+      march_costs.push_back(r.seconds / r.steady_seconds);
+      std::printf("  M = %.2f  Ubar = %.4f (%.2f Ubar*): %s, growth rate %+.5f (%d peaks) vs Re(lambda) %+.5f; %ld steps, "
+                  "%.1f inner its/step, %.1f s = %.0f steady solves\n",
+                  m, r.ubar, f, r.growth_rate < 0 ? "decays" : "grows", r.growth_rate, r.peaks, r.re_lambda, r.steps,
+                  double(r.inner_iterations) / double(std::max(1L, r.steps)), r.seconds, r.seconds / r.steady_seconds);
+      std::fflush(stdout);
+    }
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Part 4: centre-manifold reduced model at a transonic Mach number of the heavy case.
+
+void reduced_part(const options& o, const std::map<std::string, boundary>& all) {
+  const structural_case& c = heavy_case;
+  const grid_level g = level_named("coarse");
+  const double mach = o.quick ? 0.8 : 0.85;
+  std::cout << "\n=== reduced model: heavy case, coarse grid, M = " << mach << " ===\n";
+  const auto s = make_system(g, mach, c.mu_s);
+  const auto st = steady(s);
+  // the Hopf point: from the heavy coarse boundary of this run if it has this Mach number
+  hopf_point guess;
+  const auto it = all.find(c.name + "_" + g.name);
+  const boundary_point* bp = nullptr;
+  if (it != all.end())
+    for (const auto& q : it->second)
+      if (std::abs(q.mach - mach) < 1e-9) bp = &q;
+  if (bp) {
+    guess = bp->point;
+  } else {
+    std::cout << "  (no " << c.name << " " << g.name << " boundary point at M = " << mach
+              << " in this run: inverse-power start)\n";
+    guess = hopf_start(s, st.w, c.ubar_guess, c.omega_guess);
+  }
+  guess.w = st.w;
+  hopf_krylov_options hk;
+  hk.fill_level = o.fill;
+  hopf_result h = solve_hopf_krylov<4>(s, guess, hopf_opts("reduced-model Hopf point"), hk);
+  h.point.mu = std::abs(h.point.mu);
+  const hopf_point& hp = h.point;
+  std::printf("  Hopf point: Ubar* = %.8f, omega* = %.8f\n", hp.mu, hp.omega);
+
+  const auto t0 = clk::now();
+  const auto cm = reduce_to_centre_manifold(s, hp, taylor_products<double>{});
+  const double t_taylor = seconds_since(t0);
+  csv_writer cc(o.out / "reduced_coefficients.csv", "provider,h,re_G20,im_G20,re_G11,im_G11,re_g21,im_g21,re_c1,im_c1,l1,seconds");
+  auto row = [&](const std::string& name, double hstep, const centre_manifold_coefficients& k, double sec) {
+    cc.row({name, hstep, k.G20.real(), k.G20.imag(), k.G11.real(), k.G11.imag(), k.g21.real(), k.g21.imag(),
+            k.c1.real(), k.c1.imag(), k.l1, sec});
+    std::printf("  %-12s h = %-8.1e  G20 = %+.6e %+.6ei  G11 = %+.6e %+.6ei  g21 = %+.6e %+.6ei  l1 = %+.8e  (%.2f s)\n",
+                name.c_str(), hstep, k.G20.real(), k.G20.imag(), k.G11.real(), k.G11.imag(), k.g21.real(), k.g21.imag(),
+                k.l1, sec);
+  };
+  row("taylor", 0.0, cm, t_taylor);
+  // Finite differences: the limiter makes the residual strongly curved on small scales, so
+  // double differences have no usable step; double-double ones do (the original work's reason
+  // for quad-double arithmetic).
+  for (double hstep : {1e-3, 1e-5}) {
+    const auto t1 = clk::now();
+    const auto k = reduce_to_centre_manifold(s, hp, fd_products<double>{hstep});
+    row("fd<double>", hstep, k, seconds_since(t1));
+  }
+  for (double hstep : {1e-6, 1e-9}) {
+    const auto t1 = clk::now();
+    const auto k = reduce_to_centre_manifold(s, hp, fd_products<dd_real>{hstep});
+    row("fd<dd>", hstep, k, seconds_since(t1));
+  }
+  std::printf("  adjoint: %d inverse-power iterations, ||A^T q + i omega q|| / ||q|| = %.2e; l1 = %+.6e: %s Hopf bifurcation\n",
+              cm.adjoint_iterations, cm.q_residual, cm.l1, cm.l1 < 0 ? "SUPERCRITICAL (stable LCO above Ubar*)"
+                                                                       : "SUBCRITICAL (unstable LCO below Ubar*)");
+  const centre_manifold_model model(cm);
+
+  // damping below the boundary: reduced eigenvalue vs the exact one and one time-marching run
+  csv_writer dc(o.out / "reduced_damping.csv", "ubar,re_reduced,im_reduced,re_exact,im_exact,growth_march");
+  vec<cplx> p = hp.p;
+  for (double f : {0.90, 0.93, 0.95, 0.97, 0.99, 1.01, 1.03}) {
+    const double ubar = f * hp.mu;
+    const cplx lr = model.eigenvalue(ubar - hp.mu);
+    const eigen_pair ep = inverse_power(s.jacobian(st.w, ubar), cplx(0.0, hp.omega), {}, &p);
+    double growth = NAN;
+    if (std::abs(f - 0.97) < 1e-9 && o.verify) {
+      boundary_point b{mach, hp.mu, hp.omega, 0, 0, 0, 0, hp};
+      const march_result r = time_march(c, g, b, f, o.quick ? 2.0 : 3.0, o);
+      growth = r.growth_rate;
+      std::printf("  time marching at %.2f Ubar*: growth rate %+.6f (%d peaks, %.1f s)\n", f, growth, r.peaks, r.seconds);
+    }
+    dc.row({ubar, lr.real(), lr.imag(), ep.lambda.real(), std::abs(ep.lambda.imag()), growth});
+    std::printf("  Ubar = %.5f (%.2f Ubar*): reduced lambda = %+.6f %+.6fi, exact %+.6f %+.6fi\n", ubar, f, lr.real(),
+                lr.imag(), ep.lambda.real(), std::abs(ep.lambda.imag()));
+  }
+  // LCO amplitude (pitch) where the reduced model has a cycle
+  csv_writer lc(o.out / "reduced_lco.csv", "ubar,alpha_amplitude,z_amplitude,frequency,stable");
+  const Eigen::Index ia = s.flow_size() + 2;
+  for (int k = 1; k <= 10; ++k) {
+    const double dmu = (cm.l1 < 0 ? 1.0 : -1.0) * 0.005 * k * hp.mu;
+    const auto l = model.lco(dmu);
+    if (!l.exists) continue;
+    const auto [amp, mean] = model.component_amplitude(ia, dmu);
+    (void)mean;
+    lc.row({hp.mu + dmu, amp, l.amplitude, l.frequency, static_cast<long long>(l.stable)});
+    std::printf("  LCO at Ubar = %.5f: pitch amplitude %.5f rad, frequency %.5f, %s\n", hp.mu + dmu, amp, l.frequency,
+                l.stable ? "stable" : "unstable");
+  }
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  options o;
+  try {
+    for (int i = 1; i < argc; ++i) {
+      const std::string a = argv[i];
+      auto next = [&]() -> std::string {
+        require(i + 1 < argc, "option ", a, " needs a value");
+        return argv[++i];
+      };
+      if (a == "--case") {
+        const std::string v = next();
+        o.cases.clear();
+        if (v == "light" || v == "both") o.cases.push_back(light_case);
+        if (v == "heavy" || v == "both") o.cases.push_back(heavy_case);
+        require(!o.cases.empty(), "--case: light, heavy or both (got ", v, ")");
+      } else if (a == "--grids") {
+        o.grids.clear();
+        std::stringstream ss(next());
+        for (std::string t; std::getline(ss, t, ',');) o.grids.push_back(level_named(t));
+      } else if (a == "--mach-min") {
+        o.mach_min = std::stod(next());
+      } else if (a == "--mach-max") {
+        o.mach_max = std::stod(next());
+      } else if (a == "--mach-step") {
+        o.mach_step = std::stod(next());
+      } else if (a == "--method") {
+        o.method = next();
+        require(o.method == "natural" || o.method == "arclength", "--method: natural or arclength (got ", o.method, ")");
+      } else if (a == "--fill") {
+        o.fill = std::stoi(next());
+      } else if (a == "--verify-grid") {
+        o.verify_grid = level_named(next());
+      } else if (a == "--skip-spectra") {
+        o.spectra = false;
+      } else if (a == "--skip-boundaries") {
+        o.boundaries = false;
+      } else if (a == "--skip-verify") {
+        o.verify = false;
+      } else if (a == "--skip-reduced") {
+        o.reduced = false;
+      } else if (a == "--quick") {
+        o.quick = true;
+      } else if (!a.empty() && a[0] != '-') {
+        o.out = a;
+      } else {
+        throw input_error("unknown option " + a);
+      }
+    }
+    if (o.quick) {
+      o.grids = {level_named("coarse")};
+      o.verify_grid = level_named("coarse");
+      o.mach_step = o.mach_step > 0 ? o.mach_step : 0.1;
+      o.mach_max = std::min(o.mach_max, 0.8);
+    }
+    std::filesystem::create_directories(o.out);
+    const auto t0 = clk::now();
+    if (o.spectra) spectra_part(o);
+    std::map<std::string, boundary> all;
+    if (o.boundaries) all = boundaries_part(o);
+    std::vector<double> march_costs;
+    if (o.verify) verification_part(o, all, march_costs);
+    if (o.reduced) reduced_part(o, all);
+    // cost table
+    {
+      csv_writer csv(o.out / "costs.csv", "case,grid,quantity,ratio_to_steady");
+      std::cout << "\n=== cost per unit steady solve (same run, same machine) ===\n";
+      for (const auto& [key, b] : all) {
+        double hopf = 0, st = 0;
+        for (std::size_t k = 1; k < b.size(); ++k) {  // the first point includes the inverse-power start
+          hopf += b[k].hopf_seconds;
+          st += b[k].steady_seconds;
+        }
+        if (b.size() > 1) {
+          std::printf("  %-22s Hopf point / steady solve = %.2f (mean over %zu continued points)\n", key.c_str(),
+                      hopf / st, b.size() - 1);
+          csv.row({key, std::string(""), std::string("hopf_per_steady"), hopf / st});
+        }
+      }
+      for (double r : march_costs) {
+        std::printf("  time-marching run (4 cycles) / steady solve = %.1f\n", r);
+        csv.row({std::string("light"), o.verify_grid.name, std::string("march_per_steady"), r});
+      }
+    }
+    std::cout << "\ntotal " << seconds_since(t0) << " s; results in " << o.out << "\n";
+  } catch (const std::exception& e) {
+    std::cerr << "aerofoil_flutter: " << e.what() << "\n";
+    return 1;
+  }
+  return 0;
+}

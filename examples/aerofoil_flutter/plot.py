@@ -1,0 +1,152 @@
+#!/usr/bin/env python3
+"""PNGs of the aerofoil_flutter results.
+
+Usage: /usr/bin/python3 plot.py [out_dir]   (default out/aerofoil_flutter)
+
+boundaries.png  Ubar*(M) for both cases and grids, with the time-marching points
+                (filled: decaying at 0.97 Ubar*, crosses: growing at 1.03 Ubar*)
+spectra.png     very coarse light case M = 0.5: eigenvalues at Ubar* - 0.01, Ubar*, Ubar* + 0.01
+histories.png   pitch histories of the time-marching runs
+reduced.png     reduced model (heavy case): damping vs the exact eigenvalue, LCO amplitude
+"""
+import csv
+import glob
+import os
+import sys
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+
+
+def read(path):
+    with open(path, newline="") as f:
+        return list(csv.DictReader(f))
+
+
+def col(rows, key):
+    return [float(r[key]) for r in rows]
+
+
+def boundaries(out):
+    files = sorted(glob.glob(os.path.join(out, "boundary_*_*.csv")))
+    if not files:
+        return
+    cases = sorted({os.path.basename(f).split("_")[1] for f in files})
+    fig, axes = plt.subplots(1, len(cases), figsize=(6 * len(cases), 4.5), squeeze=False)
+    ver = read(os.path.join(out, "verification.csv")) if os.path.exists(os.path.join(out, "verification.csv")) else []
+    for ax, case in zip(axes[0], cases):
+        for f in files:
+            parts = os.path.basename(f)[:-4].split("_")
+            if parts[1] != case:
+                continue
+            grid = "_".join(parts[2:])
+            rows = read(f)
+            if rows:
+                ax.plot(col(rows, "mach"), col(rows, "ubar"), "o-" if grid == "medium" else "s--", ms=3, label=f"{grid} grid")
+        for r in ver:
+            if r["case"] != case:
+                continue
+            grows = float(r["growth_rate"]) > 0
+            ax.plot(float(r["mach"]), float(r["ubar"]), "x" if grows else "o", color="r" if grows else "g", ms=8,
+                    mfc="none" if grows else "g")
+        ax.set_xlabel("Mach number")
+        ax.set_ylabel("flutter speed $\\bar U^*$")
+        ax.set_title(f"{case} case: Hopf-point stability boundary")
+        ax.grid(True, alpha=0.3)
+        ax.legend()
+    fig.tight_layout()
+    fig.savefig(os.path.join(out, "boundaries.png"), dpi=130)
+    plt.close(fig)
+
+
+def spectra(out):
+    path = os.path.join(out, "spectra.csv")
+    if not os.path.exists(path):
+        return
+    rows = read(path)
+    fig, axes = plt.subplots(1, 2, figsize=(11, 4.5))
+    styles = {-0.01: ("b", "o", "Ubar* - 0.01"), 0.0: ("k", "+", "Ubar*"), 0.01: ("r", "x", "Ubar* + 0.01")}
+    for off, (c, m, lab) in styles.items():
+        sel = [r for r in rows if abs(float(r["ubar_offset"]) - off) < 1e-12]
+        re, im = col(sel, "re"), col(sel, "im")
+        axes[0].plot(re, im, m, color=c, ms=3, label=lab, mfc="none")
+        axes[1].plot(re, im, m, color=c, ms=8, label=lab, mfc="none")
+    axes[0].set_title("full spectrum of the coupled Jacobian (very coarse, light, M = 0.5)")
+    axes[1].set_xlim(-0.03, 0.03)
+    axes[1].set_ylim(0.0, 1.2)
+    axes[1].axvline(0, color="gray", lw=0.8)
+    axes[1].set_title("near the imaginary axis: the critical pair crosses at Ubar*")
+    for ax in axes:
+        ax.set_xlabel("Re $\\lambda$")
+        ax.set_ylabel("Im $\\lambda$")
+        ax.grid(True, alpha=0.3)
+        ax.legend()
+    fig.tight_layout()
+    fig.savefig(os.path.join(out, "spectra.png"), dpi=130)
+    plt.close(fig)
+
+
+def histories(out):
+    files = sorted(glob.glob(os.path.join(out, "history_*.csv")))
+    if not files:
+        return
+    fig, ax = plt.subplots(figsize=(9, 5))
+    for f in files:
+        rows = read(f)
+        ax.plot(col(rows, "t"), col(rows, "alpha"), lw=1, label=os.path.basename(f)[8:-4])
+    ax.set_xlabel("t (c / U)")
+    ax.set_ylabel("pitch alpha (rad)")
+    ax.set_title("time marching at 0.97 and 1.03 Ubar* (BDF2, dt = 0.125)")
+    ax.grid(True, alpha=0.3)
+    ax.legend(fontsize=7)
+    fig.tight_layout()
+    fig.savefig(os.path.join(out, "histories.png"), dpi=130)
+    plt.close(fig)
+
+
+def reduced(out):
+    dpath, lpath = os.path.join(out, "reduced_damping.csv"), os.path.join(out, "reduced_lco.csv")
+    if not os.path.exists(dpath):
+        return
+    d = read(dpath)
+    n = 2 if os.path.exists(lpath) else 1
+    fig, axes = plt.subplots(1, n, figsize=(5.5 * n, 4.5), squeeze=False)
+    ax = axes[0][0]
+    ax.plot(col(d, "ubar"), col(d, "re_reduced"), "-", label="reduced model")
+    ax.plot(col(d, "ubar"), col(d, "re_exact"), "o", mfc="none", label="exact eigenvalue (inverse power)")
+    if "growth_march" in d[0]:
+        g = [(float(r["ubar"]), float(r["growth_march"])) for r in d if r["growth_march"] not in ("", "nan")]
+        if g:
+            ax.plot(*zip(*g), "x", ms=8, label="time marching")
+    ax.axhline(0, color="gray", lw=0.8)
+    ax.set_xlabel("$\\bar U$")
+    ax.set_ylabel("Re $\\lambda$ (growth rate)")
+    ax.set_title("damping of the critical mode")
+    ax.grid(True, alpha=0.3)
+    ax.legend()
+    if n == 2:
+        lrows = read(lpath)
+        ax = axes[0][1]
+        ax.plot(col(lrows, "ubar"), col(lrows, "alpha_amplitude"), "-")
+        ax.set_xlabel("$\\bar U$")
+        ax.set_ylabel("LCO pitch amplitude (rad)")
+        ax.set_title("reduced-model LCO amplitude")
+        ax.grid(True, alpha=0.3)
+    fig.tight_layout()
+    fig.savefig(os.path.join(out, "reduced.png"), dpi=130)
+    plt.close(fig)
+
+
+def main():
+    out = sys.argv[1] if len(sys.argv) > 1 else "out/aerofoil_flutter"
+    boundaries(out)
+    spectra(out)
+    histories(out)
+    reduced(out)
+    print("plots written to", out)
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,328 @@
+#pragma once
+// The reduced (symmetric) Hopf system solved by BORDERING on the complex matrix, so that the
+// only linear systems are n x n complex ones with the sparsity of A, which a BILU(k)-Krylov
+// solver handles (the original scheme of the flutter method) instead of a sparse LU of the
+// real (2n+2) system, whose fill grows too fast for CFD grids.
+//
+// Symmetric case (spec 02): the equilibrium w does not depend on mu, unknowns p = p_r + i p_i,
+// mu, omega with
+//     G(p, mu, omega) = (A(mu) - i omega I) p = 0,      s^T p = i        (s real, fixed).
+// Newton with a left-hand-side matrix L ~ A (L = A: quadratic convergence; L = the modified-
+// order Jacobian: the original scheme, linear convergence, but C = L - i omega I stays
+// invertible at the Hopf point and is well conditioned for BILU):
+//     C dp + (A_mu p) dmu - i p domega = -G,      s^T dp = i - s^T p.
+// With C x = -G, C y = A_mu p, C z = -i p, dp = x - y dmu - z domega, and the two real
+// unknowns follow from the complex border equation s^T dp = i - s^T p, i.e. the 2x2 real system
+//     [Re s.y  Re s.z; Im s.y  Im s.z] [dmu; domega] = [Re(s.x - r); Im(s.x - r)],  r = i - s^T p.
+// G is always evaluated exactly and matrix-free (jacobian_product through the templated
+// residual), so the converged point is the exact Hopf point whatever L and the linear
+// tolerance are; they change only the rate of convergence.
+//
+// Cost per Newton iteration: one complex factorisation (or BILU) and three complex solves. The
+// solver type is a template parameter with the compute/solve interface of direct.hpp:
+// direct_solver<Eigen::SparseMatrix<std::complex<double>>> (sparse LU) or
+// krylov_solver<Eigen::SparseMatrix<std::complex<double>>, B> (BILU(k) + GMRES); Krylov
+// iterations are summed into hopf_result::linear_iterations.
+//
+// With exact L and a Krylov solver C is nearly singular close to convergence (that is what a
+// Hopf point is): use the approximate L with Krylov solvers, the exact one with direct solvers.
+//
+// solve_hopf_krylov (below) avoids both the fill of a direct solver and the slow linear rate of
+// the approximate left-hand side: Newton with the EXACT real (2n+2) bordered matrix
+//     J = [[A, omega I, A_mu p_r, p_i], [-omega I, A, A_mu p_i, -p_r], [s^T, 0, 0, 0], [0, s^T, 0, 0]]
+// applied matrix-free (two real SpMVs with the exact Jacobian), solved by right-preconditioned
+// GMRES. The preconditioner is the exact inverse of the same bordered matrix with
+// A - i omega I replaced by its BILU(k) factors of the MODIFIED-ORDER L - i omega I (complex,
+// block size B): block elimination of the two border unknowns (bordered_preconditioner), so one
+// complex BILU application per GMRES iteration. J itself is non-singular at a simple Hopf
+// point, so GMRES does not meet the near-singularity of A - i omega I. Measured on the NACA 0012
+// pitch-plunge (examples/aerofoil_flutter) it keeps Newton's quadratic convergence.
+#include <Eigen/Core>
+
+#include <algorithm>
+#include <complex>
+#include <iomanip>
+#include <string>
+#include <utility>
+
+#include "../error.hpp"
+#include "../linalg/block_ilu.hpp"
+#include "../linalg/block_sparse_matrix.hpp"
+#include "../linalg/direct.hpp"
+#include "../linalg/krylov.hpp"
+#include "../nonlinear/newton.hpp"
+#include "../nonlinear/system.hpp"
+#include "hopf.hpp"
+
+namespace aerohopf {
+
+namespace internal {
+
+/// Unknowns y = [p_r, p_i, mu, omega] of the symmetric Hopf system, with its exact residual
+/// (matrix-free) and the unpacking of the converged point; shared by the bordered solvers.
+template <dynamical_system S>
+struct symmetric_hopf_problem {
+  const S& sys;
+  vec<double> w, s;
+  Eigen::Index n, N;
+
+  symmetric_hopf_problem(const S& system, const hopf_point& guess, const hopf_options& opt, hopf_normalisation mode,
+                         const char* who, vec<double>& y0)
+      : sys(system), w(guess.w), n(system.size()), N(2 * system.size() + 2) {
+    require(opt.symmetric, who, ": only the symmetric (fixed equilibrium) system is implemented; set hopf_options::symmetric");
+    check_state(sys, guess.w, guess.mu, who);
+    require(guess.p.size() == n, who, ": eigenvector has ", guess.p.size(), " entries, system ", n);
+    require(guess.p.allFinite() && guess.p.norm() > 0, who, ": eigenvector is zero or not finite");
+    require(std::isfinite(guess.omega) && std::isfinite(guess.mu), who, ": mu or omega is not finite");
+    vec<std::complex<double>> p0 = guess.p;
+    s = hopf_normalise(p0, mode);
+    y0.resize(N);
+    y0.head(n) = p0.real();
+    y0.segment(n, n) = p0.imag();
+    y0[N - 2] = guess.mu;
+    y0[N - 1] = guess.omega;
+  }
+
+  vec<double> residual(const vec<double>& y) const {
+    const double mu = y[N - 2], om = y[N - 1];
+    const vec<double> pr = y.head(n), pi = y.segment(n, n);
+    vec<double> f(N);
+    f.head(n) = jacobian_product(sys, w, mu, pr) + om * pi;
+    f.segment(n, n) = jacobian_product(sys, w, mu, pi) - om * pr;
+    f[N - 2] = s.dot(pr);
+    f[N - 1] = s.dot(pi) - 1.0;
+    return f;
+  }
+
+  /// Progress line per Newton iteration (with the running linear-iteration count).
+  void add_progress(newton_options& nopt, const hopf_options& opt, const long& linear_iterations) const {
+    if (!opt.verbose || !opt.log || nopt.observer) return;
+    std::ostream& os = *opt.log;
+    nopt.observer = [&os, label = opt.label, N = N, &linear_iterations](const newton_step_info& i) {
+      os << label << " it " << std::setw(2) << i.iteration << "  |F| " << std::scientific << std::setprecision(3)
+         << i.residual << "  mu " << std::setprecision(12) << std::defaultfloat << (*i.x)[N - 2] << "  omega "
+         << (*i.x)[N - 1] << "  linear its " << linear_iterations << (i.relaxation < 1 ? "  (relaxed)" : "") << "\n";
+    };
+  }
+
+  hopf_result result(newton_result&& nr, long linear_iterations, const hopf_options& opt) const {
+    hopf_result res;
+    res.s = s;
+    res.report = std::move(nr.report);
+    res.linear_iterations = linear_iterations;
+    const vec<double>& y = nr.x;
+    res.point.w = w;
+    res.point.mu = y[N - 2];
+    res.point.omega = y[N - 1];
+    res.point.p = vec<std::complex<double>>(n);
+    res.point.p.real() = y.head(n);
+    res.point.p.imag() = y.segment(n, n);
+    if (res.report.converged && res.point.omega < 0) {
+      res.point.omega = -res.point.omega;
+      res.point.p = res.point.p.conjugate().eval();
+    }
+    if (res.report.converged && std::abs(res.point.omega) < 1e-12 * (1 + std::abs(res.point.mu)) &&
+        opt.newton.throw_on_failure)
+      throw convergence_error(opt.label + ": converged to omega = 0 (a real eigenvalue: divergence, not Hopf)");
+    return res;
+  }
+};
+
+}  // namespace internal
+
+/// Newton on the reduced Hopf system by bordering (see the file comment). opt.symmetric must be
+/// set (w = guess.w stays fixed); opt.approximate_lhs selects L; opt.normalisation as in
+/// solve_hopf (automatic: largest component for sparse Jacobians).
+template <dynamical_system S, class ComplexSolver>
+hopf_result solve_hopf_bordered(const S& sys, const hopf_point& guess, const hopf_options& opt,
+                                ComplexSolver& solver) {
+  using C = std::complex<double>;
+  using M = jacobian_t<S>;
+  const hopf_normalisation mode = opt.normalisation != hopf_normalisation::automatic ? opt.normalisation
+                                  : is_sparse_matrix_v<M> ? hopf_normalisation::largest_component
+                                                          : hopf_normalisation::eigenvector;
+  vec<double> x;
+  const internal::symmetric_hopf_problem<S> prob(sys, guess, opt, mode, "solve_hopf_bordered", x);
+  const Eigen::Index n = prob.n, N = prob.N;
+  const vec<double>& w = prob.w;
+  const vec<double>& s = prob.s;
+  auto residual = [&](const vec<double>& y) { return prob.residual(y); };
+  long linear_iterations = 0;
+  auto count = [&] {
+    if constexpr (requires { solver.last_report().iterations; }) linear_iterations += solver.last_report().iterations;
+  };
+  auto step = [&](const vec<double>& y, const vec<double>& f, int it) {
+    const double mu = y[N - 2], om = y[N - 1];
+    vec<C> p(n), g(n);
+    p.real() = y.head(n);
+    p.imag() = y.segment(n, n);
+    g.real() = f.head(n);
+    g.imag() = f.segment(n, n);
+    const C r = C(-f[N - 2], -f[N - 1]);  // i - s^T p
+    const M l = opt.approximate_lhs ? lhs_jacobian(sys, w, mu) : M(sys.jacobian(w, mu));
+    const M amu = jacobian_d_mu(sys, w, mu);
+    solver.compute(shifted(l, C(0.0, om)));
+    vec<C> amu_p(n);
+    amu_p.real() = amu * vec<double>(y.head(n));
+    amu_p.imag() = amu * vec<double>(y.segment(n, n));
+    const vec<C> xs = solver.solve(vec<C>(-g));
+    count();
+    const vec<C> ys = solver.solve(amu_p);
+    count();
+    const vec<C> zs = solver.solve(vec<C>(C(0.0, -1.0) * p));
+    count();
+    const C sx = s.dot(xs.real()) + C(0.0, 1.0) * s.dot(xs.imag());
+    const C sy = s.dot(ys.real()) + C(0.0, 1.0) * s.dot(ys.imag());
+    const C sz = s.dot(zs.real()) + C(0.0, 1.0) * s.dot(zs.imag());
+    Eigen::Matrix2d b;
+    b << sy.real(), sz.real(), sy.imag(), sz.imag();
+    const Eigen::Vector2d rhs(sx.real() - r.real(), sx.imag() - r.imag());
+    const double det = b.determinant();
+    if (!(std::abs(det) > 1e-300) || !std::isfinite(det))
+      throw singular_matrix_error(internal::concat(opt.label, ": bordered 2x2 system singular at Newton iteration ", it,
+                                                   " (det ", det, "): mu and omega not determined"));
+    const Eigen::Vector2d d = b.partialPivLu().solve(rhs);
+    const vec<C> dp = xs - d[0] * ys - d[1] * zs;
+    vec<double> dx(N);
+    dx.head(n) = dp.real();
+    dx.segment(n, n) = dp.imag();
+    dx[N - 2] = d[0];
+    dx[N - 1] = d[1];
+    return dx;
+  };
+  newton_options nopt = opt.newton;
+  prob.add_progress(nopt, opt, linear_iterations);
+  newton_result nr = newton_iterate(residual, step, x, nopt, opt.label + " (bordered Hopf system)");
+  return prob.result(std::move(nr), linear_iterations, opt);
+}
+
+struct hopf_krylov_options {
+  int fill_level = 0;               ///< k of the complex BILU(k) of L - i omega I
+  krylov_options krylov = [] {
+    krylov_options o;
+    o.relative_tolerance = 1e-6;    ///< of each Newton correction, unless adaptive (below)
+    o.max_iterations = 2000;
+    o.restart = 80;
+    o.record_history = false;
+    return o;
+  }();
+  /// Inexact Newton forcing: relative GMRES tolerance eta_k = min(eta_max, ||F_k||), but no
+  /// tighter than needed to land below the Newton tolerance, 0.1 abs_tolerance / ||F_k||; keeps
+  /// quadratic convergence (eta_k = O(||F_k||)) without over-solving the first and last steps.
+  bool adaptive_tolerance = true;
+  double eta_max = 1e-2;
+  /// Assemble A, L and A_mu once, at the start (mu0, omega0), and use A0 + (mu - mu0) A_mu0 as
+  /// the GMRES operator and the BILU of L0 - i omega0 I as the preconditioner at every Newton
+  /// iteration. The residual stays exact, so the converged point does not change; the operator
+  /// error is O((mu - mu0)^2) (zero when A is affine in mu), which keeps superlinear
+  /// convergence from a good start (continuation) and saves the assembly and factorisation
+  /// per iteration. Off: everything re-assembled at every iterate.
+  bool reuse_matrices = true;
+  /// ... but re-assembled once |mu - mu0| > reuse_window (1 + |mu0|) or a Newton step reduced
+  /// ||F|| by less than a factor 10 (far start, e.g. a large continuation step).
+  double reuse_window = 2e-3;
+};
+
+/// Newton on the symmetric Hopf system with the exact bordered matrix, GMRES and the bordered
+/// complex-BILU(k) preconditioner of the modified-order matrix (file comment). B is the block
+/// size of the system's unknowns (4 for 2D Euler + pitch-plunge); n must be a multiple of B or
+/// is padded. opt.symmetric must be set; opt.approximate_lhs is ignored (the preconditioner
+/// always uses lhs_jacobian, the operator always the exact Jacobian).
+template <int B, dynamical_system S>
+  requires is_sparse_matrix_v<jacobian_t<S>>
+hopf_result solve_hopf_krylov(const S& sys, const hopf_point& guess, const hopf_options& opt,
+                              const hopf_krylov_options& kopt = {}) {
+  using C = std::complex<double>;
+  using M = jacobian_t<S>;
+  const hopf_normalisation mode =
+      opt.normalisation != hopf_normalisation::automatic ? opt.normalisation : hopf_normalisation::largest_component;
+  vec<double> x;
+  const internal::symmetric_hopf_problem<S> prob(sys, guess, opt, mode, "solve_hopf_krylov", x);
+  const Eigen::Index n = prob.n, N = prob.N;
+  const vec<double>& w = prob.w;
+  const vec<double>& s = prob.s;
+  auto residual = [&](const vec<double>& y) { return prob.residual(y); };
+
+  block_ilu_options io;
+  io.fill_level = kopt.fill_level;
+  io.context = opt.label + ": complex BILU(" + std::to_string(kopt.fill_level) + ") of L - i omega I";
+  block_ilu<C, B> ilu(io);
+  const Eigen::Index padded = padded_block_count(n, B) * B;
+  long linear_iterations = 0;
+  M amu;
+  block_sparse_matrix<double, B> a;  // exact Jacobian, blocked for a fast SpMV
+  double mu0 = x[N - 2], last_norm = 0;
+  auto refresh = [&](double mu, double om, bool matrices) {
+    if (matrices) {
+      a = block_sparse_matrix<double, B>::from_sparse(sys.jacobian(w, mu), B);
+      amu = jacobian_d_mu(sys, w, mu);
+      mu0 = mu;
+    }
+    const auto lb = block_sparse_matrix<double, B>::from_sparse(lhs_jacobian(sys, w, mu), B);
+    ilu.compute(shifted(lb, C(0.0, om)));
+  };
+  if (kopt.reuse_matrices) refresh(x[N - 2], x[N - 1], true);
+  auto step = [&](const vec<double>& y, const vec<double>& f, int it) {
+    const double mu = y[N - 2], om = y[N - 1];
+    const vec<double> pr = y.head(n), pi = y.segment(n, n);
+    const bool slow = it > 1 && f.norm() > 0.1 * last_norm;
+    if (!kopt.reuse_matrices || (it > 1 && (slow || std::abs(mu - mu0) > kopt.reuse_window * (1 + std::abs(mu0)))))
+      refresh(mu, om, true);
+    last_norm = f.norm();
+    const double dmu = mu - mu0;
+    // inner operator: the real form of A - i omega I on (x_re, x_im), A = A0 + dmu A_mu0
+    vec<double> tmp(n), xin = vec<double>::Zero(padded), xout(padded);
+    auto inner = [&](const vec<double>& v, vec<double>& r) {
+      xin.head(n) = v.head(n);
+      a.multiply(xin, xout);
+      r.head(n) = xout.head(n);
+      xin.head(n) = v.tail(n);
+      a.multiply(xin, xout);
+      r.tail(n) = xout.head(n);
+      if (dmu != 0) {
+        tmp.noalias() = amu * v.head(n);
+        r.head(n) += dmu * tmp;
+        tmp.noalias() = amu * v.tail(n);
+        r.tail(n) += dmu * tmp;
+      }
+      r.head(n) += om * v.tail(n);
+      r.tail(n) -= om * v.head(n);
+    };
+    // its preconditioner: complex BILU solve in the real form
+    vec<C> rc = vec<C>::Zero(padded), zc(padded);
+    auto inner_pre = [&](const vec<double>& r, vec<double>& z) {
+      rc.head(n).real() = r.head(n);
+      rc.head(n).imag() = r.tail(n);
+      ilu.apply(rc, zc);
+      z.head(n) = zc.head(n).real();
+      z.tail(n) = zc.head(n).imag();
+    };
+    Eigen::MatrixXd u(2 * n, 2), vt = Eigen::MatrixXd::Zero(2, 2 * n);
+    const M amu_now = kopt.reuse_matrices ? amu : jacobian_d_mu(sys, w, mu);
+    u.col(0) << amu_now * pr, amu_now * pi;
+    u.col(1) << pi, -pr;
+    vt.row(0).head(n) = s.transpose();
+    vt.row(1).tail(n) = s.transpose();
+    const bordered_operator<decltype(inner), double> jop(inner, 2 * n, std::move(u), std::move(vt),
+                                                         Eigen::MatrixXd::Zero(2, 2));
+    const bordered_preconditioner<decltype(inner_pre), double> jpre(jop, inner_pre);
+    krylov_options ko = kopt.krylov;
+    if (kopt.adaptive_tolerance) {
+      const double fn = f.norm();
+      ko.relative_tolerance = std::min(kopt.eta_max, std::max(fn, 0.1 * opt.newton.abs_tolerance / fn));
+    }
+    ko.context = internal::concat(opt.label, ": GMRES at Newton iteration ", it);
+    ko.throw_on_failure = true;
+    vec<double> dx = vec<double>::Zero(N);
+    const vec<double> rhs = -f;
+    const krylov_report rep = gmres<double>(jop, jpre, rhs, dx, ko);
+    linear_iterations += rep.iterations;
+    return dx;
+  };
+  newton_options nopt = opt.newton;
+  prob.add_progress(nopt, opt, linear_iterations);
+  newton_result nr = newton_iterate(residual, step, x, nopt, opt.label + " (Hopf system, BILU-GMRES)");
+  return prob.result(std::move(nr), linear_iterations, opt);
+}
+
+}  // namespace aerohopf
