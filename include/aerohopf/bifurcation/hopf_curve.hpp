@@ -45,7 +45,10 @@
 //
 // Predictor: first step along the tangent dX/dnu from J_G with the last row e_nu (needs
 // dnu/ds != 0 at the start: start away from a turning point in nu), oriented by `direction`;
-// then the secant X_k - X_{k-1} scaled to unit length in the metric. Corrector: newton_iterate
+// then the secant X_k - X_{k-1} scaled to unit length in the metric; after a failed corrector
+// the exact tangent at X_k (J_G t = e_last with the secant as last row) replaces the secant
+// (the chord points off the curve at every step size where the curve bends sharply: measured
+// on the heavy-case aerofoil near M = 0.84, where the secant stalled the trace). Corrector: newton_iterate
 // on G. Step control: halve on corrector failure (non-convergence, divergence, singular
 // matrix, NaN, any aerohopf::error thrown by family(nu) or the system, a corrector that moved
 // farther than the step from the prediction, or one that landed behind the last point), grow by
@@ -375,22 +378,28 @@ hopf_curve_result trace_hopf_curve(const F& family, double nu0, const hopf_point
   x[iom] = h0.point.omega;
   vec<double> s = refresh_s(x);
   emit(make_point(x, h0.report.iterations, 1, 0.0, seconds_since(t_start), false));
+  // Exact tangent at x: J_G with the last row c (any direction not orthogonal to the curve),
+  // J_G t = e_last, normalised in the metric. Throws singular_matrix_error.
+  auto exact_tangent = [&](const vec<double>& xx, const vec<double>& ss, const double* c) {
+    lu.compute(jacobian(xx, ss, c));
+    vec<double> e = vec<double>::Zero(N);
+    e[iom] = 1;
+    vec<double> tt = lu.solve(e);
+    const double tn = std::sqrt(ydot(tt, tt));
+    if (!(std::isfinite(tn) && tn > 0)) throw singular_matrix_error(lab + ": tangent is not finite");
+    return vec<double>(tt / tn);
+  };
   vec<double> t;
   {
     const double c_nu[3] = {0, 1, 0};
     try {
-      lu.compute(jacobian(x, s, c_nu));
-      vec<double> e = vec<double>::Zero(N);
-      e[iom] = 1;
-      t = lu.solve(e);
+      t = exact_tangent(x, s, c_nu);
     } catch (const singular_matrix_error& e) {
       throw convergence_error(internal::concat(lab, ": no tangent dX/dnu at the start (nu = ", nu0, ", mu = ", x[imu],
                                                "): a turning point of the curve in nu or a degenerate Hopf point? ",
                                                e.what()));
     }
-    const double tn = std::sqrt(ydot(t, t));
-    require(std::isfinite(tn) && tn > 0, lab, ": tangent at the start is not finite");
-    t *= double(direction) / tn;
+    if (t[inu] * direction < 0) t = -t;
   }
   if (res.points.size() >= size_t(opt.max_points)) return finish(hopf_curve_stop::max_points, "max_points reached");
 
@@ -413,6 +422,7 @@ hopf_curve_result trace_hopf_curve(const F& family, double nu0, const hopf_point
   for (;;) {
     const auto t_point = clock::now();
     int attempts = 0;
+    bool exact_t = false;  // t is the exact tangent at x (not the secant)
     std::optional<corrected> xn;
     for (;;) {
       ++attempts;
@@ -437,9 +447,27 @@ hopf_curve_result trace_hopf_curve(const F& family, double nu0, const hopf_point
       }
       if (xn) break;
       ++res.failed_correctors;
+      // First failure at this point: the secant is the chord of the last step and, where the
+      // curve bends sharply, points off the curve at any step size. Retry the same step along
+      // the exact tangent at x (oriented along the secant), then halve.
+      bool retry_same = false;
+      if (!exact_t && res.points.size() > 1) {
+        try {
+          double c[3];
+          for (int j = 0; j < 3; ++j) c[j] = sig[j] > 0 ? yv(t, j) / (sig[j] * sig[j]) : 0.0;
+          vec<double> te = exact_tangent(x, s, c);
+          if (ydot(te, t) < 0) te = -te;
+          t = std::move(te);
+          retry_same = true;
+        } catch (const error& e) {
+          last_failure += internal::concat(" (exact tangent failed: ", e.what(), ")");
+        }
+        exact_t = true;
+      }
       if (opt.verbose && opt.log)
         *opt.log << lab << ": step " << ds << " from nu = " << x[inu] << ", mu = " << x[imu] << " failed ("
-                 << last_failure << "), halving\n";
+                 << last_failure << "), " << (retry_same ? "retrying along the exact tangent" : "halving") << "\n";
+      if (retry_same) continue;
       ds *= 0.5;
       if (ds < opt.min_step) {
         const std::string why = internal::concat(
