@@ -3,6 +3,7 @@
 #include "bifurcation/cayley.hpp"
 #include "bifurcation/continuation.hpp"
 #include "bifurcation/hopf.hpp"
+#include "bifurcation/hopf_bordered.hpp"
 #include "bifurcation/hopf_curve.hpp"
 #include "bifurcation/hopf_point.hpp"
 #include "bifurcation/inverse_power.hpp"

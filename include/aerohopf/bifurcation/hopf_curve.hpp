@@ -51,7 +51,9 @@
 // on the heavy-case aerofoil near M = 0.84, where the secant stalled the trace). Corrector: newton_iterate
 // on G. Step control: halve on corrector failure (non-convergence, divergence, singular
 // matrix, NaN, any aerohopf::error thrown by family(nu) or the system, a corrector that moved
-// farther than the step from the prediction, or one that landed behind the last point), grow by
+// farther than corrector_distance x the step from the prediction, or one that landed behind the
+// last point or more than acos(min_cosine) off the predicted direction: both are jumps to another
+// sheet where the curve folds, measured on the heavy-case aerofoil near M = 0.84), grow by
 // `growth` after <= fast_iterations Newton iterations, clamp to [min_step, max_step]; below
 // min_step: convergence_error naming the last converged point, the attempted step and the last
 // failure (or, with throw_on_failure = false, stop with step_failure keeping the points). The
@@ -124,6 +126,8 @@ struct hopf_curve_options {
   std::vector<double> nu_targets;         ///< land a point exactly on each crossing of these nu
   double omega_min = 1e-6;                ///< omega at or below: Bogdanov-Takens end
   bool detect_closed = true;              ///< stop when the curve returns to its start
+  double corrector_distance = 0.5;        ///< reject a corrector farther than this x step from the prediction
+  double min_cosine = 0.5;                ///< reject a step whose direction is more than acos(this) off the tangent
   double nu_step = 0;                     ///< h of the nu differences; 0 = cbrt(eps) max(1, |nu|)
   newton_options newton = [] {
     newton_options o;
@@ -437,11 +441,14 @@ hopf_curve_result trace_hopf_curve(const F& family, double nu0, const hopf_point
         // reject a corrector that wandered (another branch) or reversed the direction
         const double moved = ydist(xn->x, xp);
         const vec<double> d = xn->x - x;
-        if (!(moved <= ds)) {
+        const double dn = std::sqrt(ydot(d, d));
+        if (!(moved <= opt.corrector_distance * ds)) {
           last_failure = internal::concat("corrector moved ", moved, " from the prediction (step ", ds, ")");
           xn.reset();
-        } else if (!(ydot(d, t) > 0)) {
-          last_failure = "the corrected point lies behind the last point";
+        } else if (!(ydot(d, t) > opt.min_cosine * dn)) {
+          // behind the last point, or far off the predicted direction: a jump to another
+          // sheet of a folded curve (measured on the heavy-case aerofoil near M = 0.84)
+          last_failure = "the corrected point lies behind the last point or off the predicted direction";
           xn.reset();
         }
       }

@@ -35,6 +35,7 @@ class csv_writer {
       else os_ << std::get<std::string>(c);
     }
     os_ << "\n";
+    os_.flush();  // long runs: every row is on disk as soon as it is computed
     if (!os_) throw error("csv_writer: write to " + path_.string() + " failed");
   }
   const std::filesystem::path& path() const { return path_; }
