@@ -393,26 +393,6 @@ std::map<std::string, boundary> boundaries_part(const options& o) {
 // ---------------------------------------------------------------------------------------------
 // Part 3: time marching at 0.97 and 1.03 Ubar* (implicit BDF2, dual time, dt = 0.125).
 
-/// Least-squares slope of log |peak| against time over the local maxima of |y| after t_skip.
-double peak_growth_rate(const std::vector<double>& t, const std::vector<double>& y, double t_skip, int* peaks) {
-  double sx = 0, sy = 0, sxx = 0, sxy = 0;
-  int n = 0;
-  for (std::size_t k = 1; k + 1 < y.size(); ++k) {
-    if (t[k] < t_skip) continue;
-    const double a = std::abs(y[k]);
-    if (a > std::abs(y[k - 1]) && a >= std::abs(y[k + 1])) {
-      const double l = std::log(a);
-      sx += t[k];
-      sy += l;
-      sxx += t[k] * t[k];
-      sxy += t[k] * l;
-      ++n;
-    }
-  }
-  if (peaks) *peaks = n;
-  return n >= 2 ? (n * sxy - sx * sy) / (n * sxx - sx * sx) : NAN;
-}
-
 struct march_result {
   double ubar = 0, growth_rate = 0, re_lambda = 0, im_lambda = 0, seconds = 0, steady_seconds = 0;
   long steps = 0, inner_iterations = 0;

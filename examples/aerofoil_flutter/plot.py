@@ -20,6 +20,21 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
 
+def save(fig, out, name):
+    fig.tight_layout()
+    fig.savefig(os.path.join(out, name), dpi=130)
+    plt.close(fig)
+
+
+def finish_axes(ax, xlabel, ylabel, title=None):
+    ax.set_xlabel(xlabel)
+    ax.set_ylabel(ylabel)
+    if title:
+        ax.set_title(title)
+    ax.grid(True, alpha=0.3)
+    ax.legend()
+
+
 def read(path):
     with open(path, newline="") as f:
         return list(csv.DictReader(f))
@@ -31,6 +46,7 @@ def col(rows, key):
 
 def boundaries(out):
     files = sorted(glob.glob(os.path.join(out, "boundary_*_*.csv")))
+    styles = {"medium": "o-", "coarse": "s--", "very_coarse": "^:"}
     if not files:
         return
     cases = sorted({os.path.basename(f).split("_")[1] for f in files})
@@ -44,21 +60,21 @@ def boundaries(out):
             grid = "_".join(parts[2:])
             rows = read(f)
             if rows:
-                ax.plot(col(rows, "mach"), col(rows, "ubar"), "o-" if grid == "medium" else "s--", ms=3, label=f"{grid} grid")
+                ax.plot(col(rows, "mach"), col(rows, "ubar"), styles.get(grid, "o-"), ms=3, label=f"{grid} grid")
+        for f in sorted(glob.glob(os.path.join(out, f"hopf_curve_{case}_*.csv"))):
+            rows = read(f)
+            grid = os.path.basename(f)[:-4].split("_", 3)[3]
+            if rows:
+                ax.plot(col(rows, "mach"), col(rows, "ubar"), "-", lw=0.8, color="gray",
+                        label=f"Hopf curve, pseudo-arclength ({grid})")
         for r in ver:
             if r["case"] != case:
                 continue
             grows = float(r["growth_rate"]) > 0
             ax.plot(float(r["mach"]), float(r["ubar"]), "x" if grows else "o", color="r" if grows else "g", ms=8,
                     mfc="none" if grows else "g")
-        ax.set_xlabel("Mach number")
-        ax.set_ylabel("flutter speed $\\bar U^*$")
-        ax.set_title(f"{case} case: Hopf-point stability boundary")
-        ax.grid(True, alpha=0.3)
-        ax.legend()
-    fig.tight_layout()
-    fig.savefig(os.path.join(out, "boundaries.png"), dpi=130)
-    plt.close(fig)
+        finish_axes(ax, "Mach number", "flutter speed $\\bar U^*$", f"{case} case: Hopf-point stability boundary")
+    save(fig, out, "boundaries.png")
 
 
 def spectra(out):
@@ -79,13 +95,8 @@ def spectra(out):
     axes[1].axvline(0, color="gray", lw=0.8)
     axes[1].set_title("near the imaginary axis: the critical pair crosses at Ubar*")
     for ax in axes:
-        ax.set_xlabel("Re $\\lambda$")
-        ax.set_ylabel("Im $\\lambda$")
-        ax.grid(True, alpha=0.3)
-        ax.legend()
-    fig.tight_layout()
-    fig.savefig(os.path.join(out, "spectra.png"), dpi=130)
-    plt.close(fig)
+        finish_axes(ax, "Re $\\lambda$", "Im $\\lambda$")
+    save(fig, out, "spectra.png")
 
 
 def histories(out):
@@ -96,14 +107,9 @@ def histories(out):
     for f in files:
         rows = read(f)
         ax.plot(col(rows, "t"), col(rows, "alpha"), lw=1, label=os.path.basename(f)[8:-4])
-    ax.set_xlabel("t (c / U)")
-    ax.set_ylabel("pitch alpha (rad)")
-    ax.set_title("time marching at 0.97 and 1.03 Ubar* (BDF2, dt = 0.125)")
-    ax.grid(True, alpha=0.3)
+    finish_axes(ax, "t (c / U)", "pitch alpha (rad)", "time marching at 0.97 and 1.03 Ubar* (BDF2, dt = 0.125)")
     ax.legend(fontsize=7)
-    fig.tight_layout()
-    fig.savefig(os.path.join(out, "histories.png"), dpi=130)
-    plt.close(fig)
+    save(fig, out, "histories.png")
 
 
 def reduced(out):
@@ -121,22 +127,13 @@ def reduced(out):
         if g:
             ax.plot(*zip(*g), "x", ms=8, label="time marching")
     ax.axhline(0, color="gray", lw=0.8)
-    ax.set_xlabel("$\\bar U$")
-    ax.set_ylabel("Re $\\lambda$ (growth rate)")
-    ax.set_title("damping of the critical mode")
-    ax.grid(True, alpha=0.3)
-    ax.legend()
+    finish_axes(ax, "$\\bar U$", "Re $\\lambda$ (growth rate)", "damping of the critical mode")
     if n == 2:
         lrows = read(lpath)
         ax = axes[0][1]
-        ax.plot(col(lrows, "ubar"), col(lrows, "alpha_amplitude"), "-")
-        ax.set_xlabel("$\\bar U$")
-        ax.set_ylabel("LCO pitch amplitude (rad)")
-        ax.set_title("reduced-model LCO amplitude")
-        ax.grid(True, alpha=0.3)
-    fig.tight_layout()
-    fig.savefig(os.path.join(out, "reduced.png"), dpi=130)
-    plt.close(fig)
+        ax.plot(col(lrows, "ubar"), col(lrows, "alpha_amplitude"), "-", label="Taylor coefficients (not verified)")
+        finish_axes(ax, "$\\bar U$", "LCO pitch amplitude (rad)", "reduced-model LCO amplitude")
+    save(fig, out, "reduced.png")
 
 
 def main():

@@ -157,6 +157,25 @@ TEST(Bdf2, FrozenMatrixKrylovAndResidualDropReachTheNewtonSolution) {
   EXPECT_THROW(integrate_bdf2(sm, mu, w0, 0.0, 0.1, bad), input_error);
 }
 
+// The growth-rate estimator against a closed form: a damped cosine with a phase and a few
+// samples per period (peaks refined only to the sampling) gives sigma to the sampling accuracy.
+TEST(Bdf2, PeakGrowthRateOfADampedCosine) {
+  for (double sigma : {-0.05, 0.0, 0.03}) {
+    std::vector<double> t, y;
+    for (int k = 0; k <= 4000; ++k) {
+      t.push_back(0.01 * k);
+      y.push_back(std::exp(sigma * t.back()) * std::cos(2.0 * t.back() + 0.4));
+    }
+    int peaks = 0;
+    EXPECT_NEAR(peak_growth_rate(t, y, 1.0, &peaks), sigma, 1e-4) << "sigma " << sigma;
+    EXPECT_GE(peaks, 20);  // both signs: two peaks per period of |y|
+  }
+  int peaks = -1;
+  EXPECT_TRUE(std::isnan(peak_growth_rate({0.0, 1.0}, {1.0, 2.0}, 0.0, &peaks)));
+  EXPECT_EQ(peaks, 0);
+  EXPECT_THROW(peak_growth_rate({0.0}, {1.0, 2.0}, 0.0), input_error);
+}
+
 TEST(Bdf2, HistoryAndErrors) {
   const linear_system s;
   vec<double> w0(3);

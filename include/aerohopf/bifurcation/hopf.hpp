@@ -91,6 +91,13 @@ inline vec<double> hopf_normalise(vec<std::complex<double>>& p, hopf_normalisati
   return s;
 }
 
+/// `automatic` made concrete for matrix type M: largest_component for sparse, eigenvector for dense.
+template <class M>
+hopf_normalisation resolve_normalisation(hopf_normalisation requested) {
+  if (requested != hopf_normalisation::automatic) return requested;
+  return is_sparse_matrix_v<M> ? hopf_normalisation::largest_component : hopf_normalisation::eigenvector;
+}
+
 /// Start point for the Hopf Newton iteration: inverse power at (w, mu) with shift i omega_guess.
 template <dynamical_system S>
 hopf_point hopf_start(const S& sys, const vec<double>& w, double mu, double omega_guess,
@@ -116,9 +123,7 @@ hopf_result solve_hopf(const S& sys, const hopf_point& guess, const hopf_options
   require(std::isfinite(guess.omega), "solve_hopf: omega is not finite");
 
   vec<std::complex<double>> p = guess.p;
-  const hopf_normalisation mode = opt.normalisation != hopf_normalisation::automatic ? opt.normalisation
-                                   : is_sparse_matrix_v<M> ? hopf_normalisation::largest_component
-                                                           : hopf_normalisation::eigenvector;
+  const hopf_normalisation mode = resolve_normalisation<M>(opt.normalisation);
   const vec<double> s = hopf_normalise(p, mode);
   const bool sym = opt.symmetric;
   const Eigen::Index off = sym ? 0 : n;  // offset of p_r in the unknown vector

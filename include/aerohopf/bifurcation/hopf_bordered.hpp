@@ -77,8 +77,8 @@ struct symmetric_hopf_problem {
   vec<double> w, s;
   Eigen::Index n, N;
 
-  symmetric_hopf_problem(const S& system, const hopf_point& guess, const hopf_options& opt, hopf_normalisation mode,
-                         const char* who, vec<double>& y0)
+  symmetric_hopf_problem(const S& system, const hopf_point& guess, const hopf_options& opt, const char* who,
+                         vec<double>& y0)
       : sys(system), w(guess.w), n(system.size()), N(2 * system.size() + 2) {
     require(opt.symmetric, who, ": only the symmetric (fixed equilibrium) system is implemented; set hopf_options::symmetric");
     check_state(sys, guess.w, guess.mu, who);
@@ -86,7 +86,7 @@ struct symmetric_hopf_problem {
     require(guess.p.allFinite() && guess.p.norm() > 0, who, ": eigenvector is zero or not finite");
     require(std::isfinite(guess.omega) && std::isfinite(guess.mu), who, ": mu or omega is not finite");
     vec<std::complex<double>> p0 = guess.p;
-    s = hopf_normalise(p0, mode);
+    s = hopf_normalise(p0, resolve_normalisation<jacobian_t<S>>(opt.normalisation));
     y0.resize(N);
     y0.head(n) = p0.real();
     y0.segment(n, n) = p0.imag();
@@ -149,11 +149,8 @@ hopf_result solve_hopf_bordered(const S& sys, const hopf_point& guess, const hop
                                 ComplexSolver& solver) {
   using C = std::complex<double>;
   using M = jacobian_t<S>;
-  const hopf_normalisation mode = opt.normalisation != hopf_normalisation::automatic ? opt.normalisation
-                                  : is_sparse_matrix_v<M> ? hopf_normalisation::largest_component
-                                                          : hopf_normalisation::eigenvector;
   vec<double> x;
-  const internal::symmetric_hopf_problem<S> prob(sys, guess, opt, mode, "solve_hopf_bordered", x);
+  const internal::symmetric_hopf_problem<S> prob(sys, guess, opt, "solve_hopf_bordered", x);
   const Eigen::Index n = prob.n, N = prob.N;
   const vec<double>& w = prob.w;
   const vec<double>& s = prob.s;
@@ -247,10 +244,8 @@ hopf_result solve_hopf_krylov(const S& sys, const hopf_point& guess, const hopf_
                               const hopf_krylov_options& kopt = {}) {
   using C = std::complex<double>;
   using M = jacobian_t<S>;
-  const hopf_normalisation mode =
-      opt.normalisation != hopf_normalisation::automatic ? opt.normalisation : hopf_normalisation::largest_component;
   vec<double> x;
-  const internal::symmetric_hopf_problem<S> prob(sys, guess, opt, mode, "solve_hopf_krylov", x);
+  const internal::symmetric_hopf_problem<S> prob(sys, guess, opt, "solve_hopf_krylov", x);
   const Eigen::Index n = prob.n, N = prob.N;
   const vec<double>& w = prob.w;
   const vec<double>& s = prob.s;

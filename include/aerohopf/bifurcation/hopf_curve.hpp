@@ -213,9 +213,7 @@ hopf_curve_result trace_hopf_curve(const F& family, double nu0, const hopf_point
   require(h0.point.omega > opt.omega_min, lab, ": start point has omega = ", h0.point.omega,
           " <= omega_min (not a Hopf point)");
   const Eigen::Index N = 3 * n + 3, ipr = n, ipi = 2 * n, imu = 3 * n, inu = 3 * n + 1, iom = 3 * n + 2;
-  const hopf_normalisation mode = opt.normalisation != hopf_normalisation::automatic ? opt.normalisation
-                                  : is_sparse_matrix_v<M> ? hopf_normalisation::largest_component
-                                                          : hopf_normalisation::eigenvector;
+  const hopf_normalisation mode = resolve_normalisation<M>(opt.normalisation);
   const double sig[3] = {opt.mu_scale, opt.nu_scale, opt.omega_scale};
   auto yv = [&](const vec<double>& x, int j) { return x[imu + j]; };
   // scaled metric on y = (mu, nu, omega)

@@ -25,4 +25,29 @@ inline long step_count(double t0, double t_end, double dt, const char* who) {
 }
 }  // namespace internal
 
+/// Exponential growth rate of an oscillating signal: least-squares slope of log |y| against t
+/// over the local maxima of |y| (peaks of both signs) at t >= t_skip. For y ~ e^{sigma t}
+/// cos(omega t) it returns sigma (the real part of the mode's eigenvalue), independent of the
+/// phase. peaks (optional) receives the number of maxima used; fewer than two gives NaN.
+inline double peak_growth_rate(const std::vector<double>& t, const std::vector<double>& y, double t_skip,
+                               int* peaks = nullptr) {
+  require(t.size() == y.size(), "peak_growth_rate: ", t.size(), " times for ", y.size(), " values");
+  double sx = 0, sy = 0, sxx = 0, sxy = 0;
+  int n = 0;
+  for (std::size_t k = 1; k + 1 < y.size(); ++k) {
+    if (t[k] < t_skip) continue;
+    const double a = std::abs(y[k]);
+    if (a > std::abs(y[k - 1]) && a >= std::abs(y[k + 1])) {
+      const double l = std::log(a);
+      sx += t[k];
+      sy += l;
+      sxx += t[k] * t[k];
+      sxy += t[k] * l;
+      ++n;
+    }
+  }
+  if (peaks) *peaks = n;
+  return n >= 2 ? (n * sxy - sx * sy) / (n * sxx - sx * sx) : NAN;
+}
+
 }  // namespace aerohopf
