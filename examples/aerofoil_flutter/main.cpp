@@ -108,7 +108,6 @@ std::string fixed(double x, int digits) {
 struct steady_result {
   vec<double> w;
   double seconds = 0;
-  int steps = 0;
 };
 steady_result steady(const aerofoil_system& s) {
   const auto t0 = clk::now();
@@ -264,7 +263,7 @@ boundary natural_boundary(const structural_case& c, const grid_level& g, const s
         const auto it = std::find_if(coarser->begin(), coarser->end(),
                                      [&](const boundary_point& p) { return std::abs(p.mach - m) < 1e-9; });
         require(it != coarser->end(), "no coarse-grid point at M = ", m, " to start the finer grid from");
-        const auto sc = make_system(level_named(g.name == "medium" ? "coarse" : "very_coarse"), m, c.mu_s);
+        const auto sc = make_system({"coarser", g.stride * coarser_ratio}, m, c.mu_s);
         guess = it->point;
         guess.p = s.prolong_from<cplx>(sc, coarser_ratio, it->point.p);
       } else {
@@ -285,7 +284,6 @@ boundary natural_boundary(const structural_case& c, const grid_level& g, const s
       if (p) {
         p->hopf_seconds += start_seconds;
         write(*p);
-        step = std::max(step, 1e-9);
         continue;
       }
       if (b.empty())
@@ -344,9 +342,8 @@ boundary arclength_boundary(const structural_case& c, const grid_level& g, const
   ho.observer = [&](const hopf_curve_point& p) {
     curve.row({p.nu, std::abs(p.mu), p.omega, static_cast<long long>(p.newton_iterations),
                static_cast<long long>(p.attempts), p.step, p.seconds, static_cast<long long>(p.landed)});
-    if (!p.landed && b.size() > 0) return;
-    const bool listed = std::any_of(machs.begin(), machs.end(), [&](double m) { return std::abs(m - p.nu) < 1e-9; });
-    if (!listed) return;
+    // the boundary: the start and the points landed on the listed Mach numbers
+    if (std::none_of(machs.begin(), machs.end(), [&](double m) { return std::abs(m - p.nu) < 1e-9; })) return;
     const auto st = steady(make_system(g, p.nu, c.mu_s));
     boundary_point q{p.nu, std::abs(p.mu), p.omega, p.newton_iterations, 0, p.seconds, st.seconds, p.point()};
     b.push_back(q);

@@ -179,9 +179,8 @@ hopf_result solve_hopf_bordered(const S& sys, const hopf_point& guess, const hop
     count();
     const vec<C> zs = solver.solve(vec<C>(C(0.0, -1.0) * p));
     count();
-    const C sx = s.dot(xs.real()) + C(0.0, 1.0) * s.dot(xs.imag());
-    const C sy = s.dot(ys.real()) + C(0.0, 1.0) * s.dot(ys.imag());
-    const C sz = s.dot(zs.real()) + C(0.0, 1.0) * s.dot(zs.imag());
+    const vec<C> sc = s.template cast<C>();  // real: dot() conjugates nothing
+    const C sx = sc.dot(xs), sy = sc.dot(ys), sz = sc.dot(zs);
     Eigen::Matrix2d b;
     b << sy.real(), sz.real(), sy.imag(), sz.imag();
     const Eigen::Vector2d rhs(sx.real() - r.real(), sx.imag() - r.imag());
@@ -219,8 +218,8 @@ struct hopf_krylov_options {
   /// quadratic convergence (eta_k = O(||F_k||)) without over-solving the first and last steps.
   bool adaptive_tolerance = true;
   double eta_max = 1e-2;
-  double forcing_exponent = 1.0;
-  bool precondition_exact = false;  ///< BILU(k) of the exact A - i omega I instead of the modified-order one  ///< eta_k = ||F_k||^e: 1 quadratic, 0.5 order 1.5 with cheaper solves
+  double forcing_exponent = 1.0;     ///< eta_k = ||F_k||^e: 1 quadratic, 0.5 order 1.5 with cheaper solves
+  bool precondition_exact = false;   ///< BILU(k) of the exact A - i omega I instead of the modified-order one
   /// Assemble A, L and A_mu once, at the start (mu0, omega0), and use A0 + (mu - mu0) A_mu0 as
   /// the GMRES operator and the BILU of L0 - i omega0 I as the preconditioner at every Newton
   /// iteration. The residual stays exact, so the converged point does not change; the operator
@@ -260,24 +259,25 @@ hopf_result solve_hopf_krylov(const S& sys, const hopf_point& guess, const hopf_
   M amu;
   block_sparse_matrix<double, B> a;  // exact Jacobian, blocked for a fast SpMV
   double mu0 = x[N - 2], last_norm = 0;
-  auto refresh = [&](double mu, double om, bool matrices) {
-    if (matrices) {
-      a = block_sparse_matrix<double, B>::from_sparse(sys.jacobian(w, mu), B);
-      amu = jacobian_d_mu(sys, w, mu);
-      mu0 = mu;
-    }
-    const auto lb = block_sparse_matrix<double, B>::from_sparse(
-        kopt.precondition_exact ? M(sys.jacobian(w, mu)) : M(lhs_jacobian(sys, w, mu)), B);
+  // A, A_mu and the BILU of L - i omega I at (mu, omega); the exact Jacobian is assembled once
+  // and also serves as L when precondition_exact.
+  auto refresh = [&](double mu, double om) {
+    const M exact = sys.jacobian(w, mu);
+    a = block_sparse_matrix<double, B>::from_sparse(exact, B);
+    amu = jacobian_d_mu(sys, w, mu);
+    mu0 = mu;
+    const auto lb = kopt.precondition_exact ? a : block_sparse_matrix<double, B>::from_sparse(lhs_jacobian(sys, w, mu), B);
     ilu.compute(shifted(lb, C(0.0, om)));
   };
-  if (kopt.reuse_matrices) refresh(x[N - 2], x[N - 1], true);
+  if (kopt.reuse_matrices) refresh(x[N - 2], x[N - 1]);
   auto step = [&](const vec<double>& y, const vec<double>& f, int it) {
     const double mu = y[N - 2], om = y[N - 1];
     const vec<double> pr = y.head(n), pi = y.segment(n, n);
-    const bool slow = it > 1 && f.norm() > 0.1 * last_norm;
+    const double fn = f.norm();
+    const bool slow = it > 1 && fn > 0.1 * last_norm;
     if (!kopt.reuse_matrices || (it > 1 && (slow || std::abs(mu - mu0) > kopt.reuse_window * (1 + std::abs(mu0)))))
-      refresh(mu, om, true);
-    last_norm = f.norm();
+      refresh(mu, om);
+    last_norm = fn;
     const double dmu = mu - mu0;
     // inner operator: the real form of A - i omega I on (x_re, x_im), A = A0 + dmu A_mu0
     vec<double> tmp(n), xin = vec<double>::Zero(padded), xout(padded);
@@ -307,8 +307,7 @@ hopf_result solve_hopf_krylov(const S& sys, const hopf_point& guess, const hopf_
       z.tail(n) = zc.head(n).imag();
     };
     Eigen::MatrixXd u(2 * n, 2), vt = Eigen::MatrixXd::Zero(2, 2 * n);
-    const M amu_now = kopt.reuse_matrices ? amu : jacobian_d_mu(sys, w, mu);
-    u.col(0) << amu_now * pr, amu_now * pi;
+    u.col(0) << amu * pr, amu * pi;
     u.col(1) << pi, -pr;
     vt.row(0).head(n) = s.transpose();
     vt.row(1).tail(n) = s.transpose();
@@ -317,7 +316,6 @@ hopf_result solve_hopf_krylov(const S& sys, const hopf_point& guess, const hopf_
     const bordered_preconditioner<decltype(inner_pre), double> jpre(jop, inner_pre);
     krylov_options ko = kopt.krylov;
     if (kopt.adaptive_tolerance) {
-      const double fn = f.norm();
       ko.relative_tolerance =
           std::min(kopt.eta_max, std::max(std::pow(fn, kopt.forcing_exponent), 0.1 * opt.newton.abs_tolerance / fn));
     }

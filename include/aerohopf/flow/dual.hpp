@@ -65,26 +65,22 @@ struct dual {
   friend bool operator==(const dual& a, const dual& b) { return a.v == b.v; }
   friend bool operator!=(const dual& a, const dual& b) { return a.v != b.v; }
 
-  friend dual sqrt(const dual& a) {
+  /// g(a) for a function with value gv = g(a.v) and derivative dg = g'(a.v) (chain rule).
+  static dual chain(const dual& a, double gv, double dg) {
     dual r;
-    r.v = std::sqrt(a.v);
-    const double f = 0.5 / r.v;
-    for (int k = 0; k < N; ++k) r.d[k] = f * a.d[k];
+    r.v = gv;
+    for (int k = 0; k < N; ++k) r.d[k] = dg * a.d[k];
     return r;
+  }
+  friend dual sqrt(const dual& a) {
+    const double s = std::sqrt(a.v);
+    return chain(a, s, 0.5 / s);
   }
   friend dual exp(const dual& a) {
-    dual r;
-    r.v = std::exp(a.v);
-    for (int k = 0; k < N; ++k) r.d[k] = r.v * a.d[k];
-    return r;
+    const double e = std::exp(a.v);
+    return chain(a, e, e);
   }
-  friend dual log(const dual& a) {
-    dual r;
-    r.v = std::log(a.v);
-    const double f = 1.0 / a.v;
-    for (int k = 0; k < N; ++k) r.d[k] = f * a.d[k];
-    return r;
-  }
+  friend dual log(const dual& a) { return chain(a, std::log(a.v), 1.0 / a.v); }
 };
 
 }  // namespace aerohopf::flow

@@ -15,8 +15,9 @@
 #include <string>
 #include <vector>
 
+#include <Eigen/Core>
+
 #include "../error.hpp"
-#include "../linalg/direct.hpp"
 
 namespace aerohopf::flow {
 
@@ -190,39 +191,32 @@ multiblock_grid<Dim> coarsen(const multiblock_grid<Dim>& fine, int m) {
 /// linear_index order (the euler_model ordering). Used for grid sequencing (a coarse-grid
 /// steady state or Hopf eigenvector as the start on the finer grid). T may be complex.
 template <int Dim, class T>
-vec<T> prolong_cells(const grid_topology<Dim>& coarse, const grid_topology<Dim>& fine, int m, const vec<T>& v, int nv) {
+Eigen::Matrix<T, Eigen::Dynamic, 1> prolong_cells(const grid_topology<Dim>& coarse, const grid_topology<Dim>& fine,
+                                                  int m, const Eigen::Matrix<T, Eigen::Dynamic, 1>& v, int nv) {
   require(m >= 1 && nv >= 1, "prolong_cells: factor ", m, " and values per cell ", nv, " must be positive");
   require(coarse.cells.size() == fine.cells.size(), "prolong_cells: ", coarse.cells.size(), " coarse blocks vs ",
           fine.cells.size(), " fine blocks");
   std::size_t nc = 0, nf = 0;
   for (std::size_t b = 0; b < fine.cells.size(); ++b) {
-    std::size_t cc = 1, cf = 1;
-    for (int d = 0; d < Dim; ++d) {
+    for (int d = 0; d < Dim; ++d)
       require(fine.cells[b][d] == m * coarse.cells[b][d], "prolong_cells: block ", b, " axis ", d, " has ",
               fine.cells[b][d], " fine cells, not ", m, " x ", coarse.cells[b][d]);
-      cc *= static_cast<std::size_t>(coarse.cells[b][d]);
-      cf *= static_cast<std::size_t>(fine.cells[b][d]);
-    }
-    nc += cc;
-    nf += cf;
+    nc += product<Dim>(coarse.cells[b]);
+    nf += product<Dim>(fine.cells[b]);
   }
   require(v.size() == static_cast<Eigen::Index>(nc) * nv, "prolong_cells: field has ", v.size(), " entries, the coarse grid ",
           nc, " cells x ", nv);
-  vec<T> out(static_cast<Eigen::Index>(nf) * nv);
+  Eigen::Matrix<T, Eigen::Dynamic, 1> out(static_cast<Eigen::Index>(nf) * nv);
   std::size_t oc = 0, of = 0;
   for (std::size_t b = 0; b < fine.cells.size(); ++b) {
-    std::size_t n_fine = 1, n_coarse = 1;
-    for (int d = 0; d < Dim; ++d) {
-      n_fine *= static_cast<std::size_t>(fine.cells[b][d]);
-      n_coarse *= static_cast<std::size_t>(coarse.cells[b][d]);
-    }
+    const std::size_t n_fine = product<Dim>(fine.cells[b]);
     for (std::size_t k = 0; k < n_fine; ++k) {
       auto i = unravel<Dim>(k, fine.cells[b]);
       for (int d = 0; d < Dim; ++d) i[d] /= m;
       const std::size_t kc = linear_index<Dim>(i, coarse.cells[b]);
       out.segment(static_cast<Eigen::Index>((of + k) * nv), nv) = v.segment(static_cast<Eigen::Index>((oc + kc) * nv), nv);
     }
-    oc += n_coarse;
+    oc += product<Dim>(coarse.cells[b]);
     of += n_fine;
   }
   return out;
