@@ -3,14 +3,18 @@
 // coupled residual (through the moving grid), the modified-order variant differs only in the
 // flow block, the analytic d_mu / A_mu against jets and differences in Ubar, the loads against
 // the flow solver's own force integration, and the symmetric equilibrium (steady flow at
-// alpha = 0, zero structural state) with zero residual for every Ubar.
+// alpha = 0, zero structural state) with zero residual for every Ubar; the contact smoothing
+// that makes the residual three times differentiable there (dd differences vs taylor<>).
 #include <gtest/gtest.h>
 
 #include <aerohopf/flow/naca_cgrid.hpp>
 #include <aerohopf/flow/steady_solver.hpp>
 #include <aerohopf/models/aerofoil.hpp>
 #include <aerohopf/nonlinear/system.hpp>
+#include <aerohopf/reduction/derivative_products.hpp>
+#include <aerohopf/scalar.hpp>
 
+#include <array>
 #include <cmath>
 #include <iostream>
 #include <random>
@@ -190,4 +194,44 @@ TEST(aerofoil_system, rejects_bad_input) {
   eo.vortex_far_field = true;
   EXPECT_THROW(aerofoil_system(euler_model<2>(coarsen(naca_cgrid(), 8), {.mach = 0.5}, eo), structure::pitch_plunge{}),
                input_error);
+}
+
+// The centre-manifold reduction needs 2nd and 3rd derivatives of the residual at the symmetric
+// equilibrium. With the exact Osher contact switch they do not exist there (the wake cut has
+// u* = 0 between mirror states, the outer boundary ub = 0: finite-difference C(v, v, v) does
+// not converge as h falls); with
+// contact_smoothing they do, and dd finite differences converge to the taylor<> value.
+TEST(aerofoil_system, contact_smoothing_makes_the_residual_smooth_at_the_symmetric_equilibrium) {
+  auto third_by = [](double delta) {
+    structure::pitch_plunge_parameters p;
+    p.mu_s = 100.0;
+    euler_options fo;
+    fo.contact_smoothing = delta;
+    const aerofoil_system s(euler_model<2>(coarsen(naca_cgrid(), 8), {.mach = 0.5, .alpha_rad = 0.0}, fo),
+                            structure::pitch_plunge(p));
+    const vec<double> w = s.steady_equilibrium();
+    vec<double> v = 0.01 * random_vector(s.size(), 7);
+    v.tail(4) << 0.01, 0.02, 0.03, -0.01;  // plunge, pitch and their rates: breaks the symmetry
+    const double mu = 4.0;
+    // the assembled exact Jacobian differentiates the smoothed switches too
+    const vec<double> wp = perturbed_state(s, 5);
+    const vec<double> ref = jacobian_product(s, wp, mu, v);
+    EXPECT_LT((s.jacobian(wp, mu) * v - ref).norm(), 1e-8 * ref.norm()) << "delta " << delta;
+    std::array<vec<double>, 3> c{taylor_products<double>{}.third(s, w, mu, v),
+                                 fd_products<dd_real>{1e-3}.third(s, w, mu, v),
+                                 fd_products<dd_real>{1e-5}.third(s, w, mu, v)};
+    return c;
+  };
+  const auto smooth = third_by(0.05);
+  const double scale = smooth[0].norm();
+  ASSERT_GT(scale, 1e-6);
+  std::cout << "smoothed: |C_fd(1e-3) - C_taylor| / |C| = " << (smooth[1] - smooth[0]).norm() / scale
+            << ", |C_fd(1e-5) - C_taylor| / |C| = " << (smooth[2] - smooth[0]).norm() / scale << "\n";
+  EXPECT_LT((smooth[1] - smooth[0]).norm(), 1e-5 * scale);
+  EXPECT_LT((smooth[2] - smooth[0]).norm(), 1e-5 * scale);
+  const auto exact = third_by(0.0);
+  const double spread = (exact[2] - exact[1]).norm() / std::max(exact[1].norm(), exact[2].norm());
+  std::cout << "exact switch: |C_fd(1e-3)| = " << exact[1].norm() << ", |C_fd(1e-5)| = " << exact[2].norm()
+            << ", relative difference " << spread << " (no third derivative)\n";
+  EXPECT_GT(spread, 0.5);
 }

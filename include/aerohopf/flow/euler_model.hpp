@@ -60,6 +60,13 @@ std::array<double, Dim> face_centre(const grid_block<S, Dim>& g, int d, const in
 struct euler_options {
   int order = 2;                   // 1: piecewise-constant states, 2: MUSCL / van Albada
   double limiter_eps = 1e-3;       // eps of the van Albada limiter (variables are O(1))
+  /// delta of the smoothed contact switches (0: exact switches): the Osher flux's choice of
+  /// intermediate state by the sign of the contact speed (osher_flux.hpp) and the far field's
+  /// upwinding of entropy and tangential velocity by the sign of the normal velocity. Set it
+  /// (e.g. 0.05) for centre-manifold reductions at a symmetric equilibrium: its wake cut and
+  /// the C-grid's outer boundary parallel to the free stream sit exactly on the switches, and
+  /// the residual is otherwise not twice differentiable there.
+  double contact_smoothing = 0.0;
   std::array<double, 3> moment_centre{0.25, 0.0, 0.0};  // reference point of the moment
   std::string force_tag;           // walls whose forces are integrated ("" = all walls)
   /// Slip-wall flux. extrapolated: pure pressure flux (0, p_w S, p_w q) with the wall pressure
@@ -272,10 +279,10 @@ class euler_model {
       f[Dim + 1] = pw * q;
       return f;
     }
-    if (opt_.order == 1) return osher_flux<S, Dim>(qm, qp, area, q, star);
+    if (opt_.order == 1) return osher_flux<S, Dim>(qm, qp, area, q, star, opt_.contact_smoothing);
     const auto ql = muscl_left<S, Dim>(qmm, qm, qp, opt_.limiter_eps);
     const auto qr = muscl_right<S, Dim>(qm, qp, qpp, opt_.limiter_eps);
-    return osher_flux<S, Dim>(ql, qr, area, q, star);
+    return osher_flux<S, Dim>(ql, qr, area, q, star, opt_.contact_smoothing);
   }
 
   /// Halo state of h from its donors' conservative states (the function whose derivative the
@@ -332,13 +339,22 @@ class euler_model {
     if (ui >= ci) return qi;   // supersonic outflow
     const S rp = ui + S(2.0 / gm1) * ci, rm = uf - S(2.0 / gm1) * cf;
     const S ub = S(0.5) * (rp + rm), cb = S(0.25 * gm1) * (rp - rm);
-    const primitive<S, Dim>& up = ub < S(0.0) ? qf : qi;  // upwind side for entropy, tangential
-    const S un_up = ub < S(0.0) ? uf : ui;
-    const S entropy = up.p / internal::power(up.rho, gamma_gas);
+    // Entropy and tangential velocity from the upwind side of the contact wave (speed ub):
+    // weight wf of the free stream = H(-ub), or its logistic smoothing with the contact
+    // smoothing delta (as in osher_flux.hpp: the outer boundary of a C-grid runs parallel to
+    // the free stream, where ub = 0 and the switch would make the residual non-smooth).
+    S wf = ub < S(0.0) ? S(1.0) : S(0.0);
+    if (opt_.contact_smoothing > 0.0) {
+      using std::exp;
+      const S arg = ub / (S(opt_.contact_smoothing) * cb);
+      if (arg < S(40.0) && arg > S(-40.0)) wf = S(1.0) / (S(1.0) + exp(S(2.0) * arg));
+    }
+    const S wi = S(1.0) - wf;
+    const S entropy = wf * qf.p / internal::power(qf.rho, gamma_gas) + wi * qi.p / internal::power(qi.rho, gamma_gas);
     primitive<S, Dim> qb;
     qb.rho = internal::power(cb * cb / (S(gamma_gas) * entropy), 1.0 / gm1);
     qb.p = qb.rho * cb * cb / S(gamma_gas);
-    for (int d = 0; d < Dim; ++d) qb.u[d] = up.u[d] + (ub - un_up) * n[d];
+    for (int d = 0; d < Dim; ++d) qb.u[d] = wf * (qf.u[d] + (ub - uf) * n[d]) + wi * (qi.u[d] + (ub - ui) * n[d]);
     return qb;
   }
 

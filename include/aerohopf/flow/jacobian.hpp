@@ -205,7 +205,7 @@ void assemble_jacobian(const euler_model<Dim>& m, const vec<double>& w, jacobian
       std::array<D2, Dim> area_d;
       for (int e = 0; e < Dim; ++e) area_d[e] = D2(mb.normal[d][k][e]);
       const auto fl = osher_flux<D2, Dim>(to_primitive<D2, Dim>(wld), to_primitive<D2, Dim>(wrd), area_d,
-                                          D2(mb.speed[d][k]));
+                                          D2(mb.speed[d][k]), nullptr, m.options().contact_smoothing);
       block dl, dr;
       for (int u = 0; u < nv; ++u)
         for (int v = 0; v < nv; ++v) {

@@ -17,6 +17,26 @@
 // On a moving face, u is the normal velocity relative to the face (the Riemann structure is
 // Galilean invariant) and the flux is the ALE flux of gas.hpp. The function is a template over
 // the scalar, so taylor<> jets differentiate exactly the branch that the value takes.
+//
+// Contact smoothing (optional, contact_width = delta > 0). The middle subpath contributes
+// H(-u*) (F(w_2/3) - F(w_1/3)) with H the Heaviside function: the flux switches from the
+// left to the right intermediate state where u* changes sign. At u* = 0 the two fluxes agree
+// (mass flux 0, pressure p* in both), and their derivatives differ by (rho_2/3 - rho_1/3) du*
+// (and the tangential-velocity jump): the flux is C0 with a kink in general, C1 where the two
+// sides are mirror images. That is exactly the wake cut of a symmetric aerofoil at zero
+// incidence (v = 0 there), so the 2nd and 3rd derivatives of the residual that the centre-
+// manifold reduction needs do not exist at its equilibrium (measured: finite-difference g21
+// grows like 1/h). With delta > 0, H(-u*) is replaced by the logistic
+//     h(u*) = 1 / (1 + exp(2 u* / (delta cbar))),   cbar = (c_1/3 + c_2/3) / 2,
+// (= (1 - tanh(u* / (delta cbar))) / 2), which is C-infinity and equals H to 1e-35 for
+// |u*| > 40 delta cbar, where the exact switch is used. The flux stays consistent (F(w, w) =
+// F(w): the bracket vanishes for equal states) and conservative; only the upwinding of the
+// contact (entropy and shear) wave on faces with |u*| <~ delta c changes, to a smooth central
+// blend. At a mirror-symmetric face (u* = 0, w_1/3 and w_2/3 mirror images) the bracket and
+// its first derivative vanish, so the flux and its Jacobian there are unchanged; faces
+// elsewhere with |u*| <~ delta c (e.g. nearly aligned with the flow) change slightly, and so
+// does the equilibrium (measured in examples/aerofoil_flutter). euler_options::contact_smoothing
+// sets delta, also for the far field's own contact switch (euler_model.hpp).
 #include <cmath>
 
 #include "gas.hpp"
@@ -51,10 +71,12 @@ struct osher_star {
 };
 
 /// Osher flux through a face with area vector area (|area| = face area) and face volume flux
-/// q_face (= face area times the normal grid speed).
+/// q_face (= face area times the normal grid speed). contact_width: delta of the contact
+/// smoothing (file comment; 0 = the exact switch).
 template <class S, int Dim>
 state<S, Dim> osher_flux(const primitive<S, Dim>& ql, const primitive<S, Dim>& qr, const vector_d<S, Dim>& area,
-                         const S& q_face, osher_star<S>* star = nullptr) {
+                         const S& q_face, osher_star<S>* star = nullptr, double contact_width = 0.0) {
+  using std::exp;
   using std::sqrt;
   constexpr double g = gamma_gas, gm1 = gamma_gas - 1.0;
   constexpr double z = gm1 / (2.0 * g);
@@ -108,11 +130,23 @@ state<S, Dim> osher_flux(const primitive<S, Dim>& ql, const primitive<S, Dim>& q
   else if (neg_l && !neg_13) add(f, flux(sonic1()), flux(ql));
   // Subpath 2 (u), from 1/3 to 2/3: lambda = u* is constant.
   const bool neg_23 = ustar + c23 < S(0.0), neg_r = ur + cr < S(0.0);
+  S arg(0.0);  // u* / (delta cbar) for the smoothed contact
+  bool smooth = false;
+  if (contact_width > 0.0) {
+    arg = ustar / (S(0.5 * contact_width) * (c13 + c23));
+    smooth = arg < S(40.0) && arg > S(-40.0);
+  }
   state<S, Dim> f23;
-  if (ustar < S(0.0) || neg_23) {
+  if (smooth && !(neg_13 || ustar < S(0.0))) f13 = flux(state13());
+  if (smooth || ustar < S(0.0) || neg_23) {
     f23 = flux(state23());
   }
-  if (ustar < S(0.0)) add(f, f23, f13);
+  if (smooth) {
+    const S h = S(1.0) / (S(1.0) + exp(S(2.0) * arg));
+    for (int k = 0; k < Dim + 2; ++k) f[k] += h * (f23[k] - f13[k]);
+  } else if (ustar < S(0.0)) {
+    add(f, f23, f13);
+  }
   // Subpath 3 (u + c), from 2/3 to R.
   if (neg_23 && neg_r) add(f, flux(qr), f23);
   else if (!neg_23 && neg_r) add(f, flux(qr), flux(sonic3()));
