@@ -195,3 +195,30 @@ TEST(Bdf2, HistoryAndErrors) {
     SUCCEED();  // the Newton matrix c - 2 y can also become singular on the way
   }
 }
+
+// Amplitude envelope against the closed form of the Landau equation dA/dt = sigma A + beta A^3
+// (supercritical: beta < 0, limit cycle at A = sqrt(-sigma / beta)):
+// A^-2 = (A0^-2 + beta / sigma) e^{-2 sigma t} - beta / sigma, signal y = m + A cos(omega t).
+TEST(Bdf2, AmplitudeEnvelopeOfALandauTransient) {
+  const double sigma = 0.02, beta = -0.05, omega = 1.3, a0 = 0.05, mean = 0.3;
+  auto amp = [&](double t) { return 1.0 / std::sqrt((1.0 / (a0 * a0) + beta / sigma) * std::exp(-2 * sigma * t) - beta / sigma); };
+  std::vector<double> t, y;
+  for (int k = 0; k <= 40000; ++k) {
+    t.push_back(0.01 * k);
+    y.push_back(mean + amp(t.back()) * std::cos(omega * t.back()));
+  }
+  const auto e = amplitude_envelope(t, y, 1.0);
+  ASSERT_GT(e.size(), 150u);
+  double worst_a = 0, worst_g = 0;
+  for (const auto& s : e) {
+    const double a = amp(s.t);
+    worst_a = std::max(worst_a, std::abs(s.amplitude - a) / a);
+    worst_g = std::max(worst_g, std::abs(s.growth_rate - (sigma + beta * a * a)));
+  }
+  std::cout << "envelope: max relative amplitude error " << worst_a << ", max growth-rate error " << worst_g << "\n";
+  EXPECT_LT(worst_a, 1e-3);
+  EXPECT_LT(worst_g, 5e-5);  // rates run from +0.02 to ~0 at the limit cycle (0.632)
+  EXPECT_NEAR(e.back().amplitude, std::sqrt(-sigma / beta), 2e-3);
+  EXPECT_TRUE(amplitude_envelope({0.0, 1.0}, {1.0, 2.0}, 0.0).empty());
+  EXPECT_THROW(amplitude_envelope({0.0}, {1.0, 2.0}, 0.0), input_error);
+}

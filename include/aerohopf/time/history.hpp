@@ -2,6 +2,7 @@
 // A stored time history (t_k, y_k) shared by the explicit and implicit integrators, and the
 // step count rule they share: a requested step dt is rounded down so that an integer number
 // of equal steps ends exactly on t_end (histories of different runs then align in time).
+#include <algorithm>
 #include <cmath>
 #include <vector>
 
@@ -48,6 +49,53 @@ inline double peak_growth_rate(const std::vector<double>& t, const std::vector<d
   }
   if (peaks) *peaks = n;
   return n >= 2 ? (n * sxy - sx * sy) / (n * sxx - sx * sx) : NAN;
+}
+
+/// One sample of the amplitude envelope of an oscillation (amplitude_envelope).
+struct amplitude_sample {
+  double t = 0;            ///< mid time between two successive extrema
+  double amplitude = 0;    ///< half the swing between them
+  double growth_rate = 0;  ///< d ln(amplitude) / dt there (NaN with fewer than two samples)
+};
+
+/// Amplitude envelope of an oscillation whose amplitude and mean vary slowly (a transient
+/// towards or away from a limit cycle): the extrema of y at t >= t_skip, each refined by the
+/// parabola through its three samples; between successive extrema (a maximum and a minimum)
+/// the amplitude is half the swing, A = |y_k - y_{k-1}| / 2, at t = (t_k + t_{k-1}) / 2 (for
+/// y = A(t) cos(omega t) + mean this is A(t) to O((T A'/A)^2)); the growth rate is
+/// d ln A / dt by central differences of the samples (one-sided at the ends). Plotting the
+/// growth rate against the amplitude gives the amplitude-dependent damping; its zero is the
+/// limit-cycle amplitude (stable where the slope is negative).
+inline std::vector<amplitude_sample> amplitude_envelope(const std::vector<double>& t, const std::vector<double>& y,
+                                                        double t_skip) {
+  require(t.size() == y.size(), "amplitude_envelope: ", t.size(), " times for ", y.size(), " values");
+  std::vector<double> te, ye;  // refined extrema
+  for (std::size_t k = 1; k + 1 < y.size(); ++k) {
+    if (t[k] < t_skip) continue;
+    const bool is_max = y[k] > y[k - 1] && y[k] >= y[k + 1], is_min = y[k] < y[k - 1] && y[k] <= y[k + 1];
+    if (!is_max && !is_min) continue;
+    // parabola through (t[k-1], t[k], t[k+1]); equal steps are not assumed
+    const double h1 = t[k] - t[k - 1], h2 = t[k + 1] - t[k];
+    const double d1 = (y[k] - y[k - 1]) / h1, d2 = (y[k + 1] - y[k]) / h2;
+    const double c2 = (d2 - d1) / (h1 + h2);  // y ~ y[k] + b (s - t[k]) + c2 (s - t[k])^2
+    const double b = d1 + c2 * h1;
+    double tk = t[k], yk = y[k];
+    if (c2 != 0.0) {
+      const double ds = std::clamp(-b / (2.0 * c2), -h1, h2);
+      tk += ds;
+      yk += b * ds + c2 * ds * ds;
+    }
+    te.push_back(tk);
+    ye.push_back(yk);
+  }
+  std::vector<amplitude_sample> r;
+  for (std::size_t k = 1; k < te.size(); ++k)
+    r.push_back({0.5 * (te[k] + te[k - 1]), 0.5 * std::abs(ye[k] - ye[k - 1]), NAN});
+  for (std::size_t k = 0; k < r.size() && r.size() >= 2; ++k) {
+    const std::size_t a = k == 0 ? 0 : k - 1, b = k + 1 == r.size() ? k : k + 1;
+    r[k].growth_rate = std::log(r[b].amplitude / r[a].amplitude) / (r[b].t - r[a].t);
+  }
+  return r;
 }
 
 }  // namespace aerohopf
