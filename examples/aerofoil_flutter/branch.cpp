@@ -1,0 +1,174 @@
+// The flutter boundary Ubar(M) of the pitch-plunge NACA 0012 (spec 05) traced from ONE start by
+// pseudo-arclength continuation of the symmetric Hopf curve with Krylov linear algebra and a
+// nested steady solve per Mach number (trace_symmetric_hopf_curve, bifurcation/
+// hopf_curve_symmetric.hpp): through the steep transonic branches of the heavy case (M ~ 0.83
+// and 0.89) where natural continuation in M stops, at grid sizes where the full-system tracer
+// (hopf_curve.hpp, sparse LU) is too expensive.
+//
+// Usage: aerofoil_branch [--grid very_coarse|coarse|medium] [--case heavy|light]
+//                        [--mach-min 0.78] [--mach-max 0.95] [--out out/aerofoil_flutter]
+//                        [--fill k] [--max-points N]
+// Start: steady flow at mach-min from the free stream, inverse power at the case's (Ubar, omega)
+// guess, solve_hopf_krylov (as main.cpp). Every crossing of M = 0.01 k is landed exactly.
+// Output: <out>/hopf_curve_sym_<case>_<grid>.csv
+//   mach,ubar,omega,newton_iterations,linear_iterations,step,seconds,landed
+// and a summary: points, turning points of the curve in M (and extrema of Ubar), cost per
+// point against one steady solve from the free stream.
+#include <aerohopf/bifurcation/hopf.hpp>
+#include <aerohopf/bifurcation/hopf_curve_symmetric.hpp>
+#include <aerohopf/io/csv.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <iostream>
+#include <string>
+#include <vector>
+
+#include "setup.hpp"
+
+using namespace aerohopf;
+using namespace aerofoil_example;
+
+namespace {
+
+struct options {
+  std::filesystem::path out = "out/aerofoil_flutter";
+  grid_level grid = level_named("coarse");
+  structural_case scase = heavy_case;
+  double mach_min = 0.78, mach_max = 0.95;
+  int fill = 1;
+  int max_points = 400;
+};
+
+/// Vertex of the parabola through three points (x_k, y_k): a turning point of y(x)... located
+/// by fitting x as a quadratic in y (smooth through a turn of x) and returning (x*, y*).
+std::pair<double, double> parabola_vertex(const double* x, const double* y) {
+  // x = a + b y + c y^2 through the three points
+  const double y0 = y[0], y1 = y[1], y2 = y[2];
+  const double d01 = (x[1] - x[0]) / (y1 - y0), d12 = (x[2] - x[1]) / (y2 - y1);
+  const double c = (d12 - d01) / (y2 - y0);
+  const double b = d01 - c * (y0 + y1);
+  if (!(std::abs(c) > 0)) return {x[1], y[1]};
+  const double ys = -b / (2 * c);
+  return {x[1] + b * (ys - y1) + c * (ys * ys - y1 * y1), ys};
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::setvbuf(stdout, nullptr, _IOLBF, 0);
+  std::cout << std::unitbuf;
+  options o;
+  try {
+    for (int i = 1; i < argc; ++i) {
+      const std::string a = argv[i];
+      auto next = [&]() -> std::string {
+        require(i + 1 < argc, "option ", a, " needs a value");
+        return argv[++i];
+      };
+      if (a == "--grid") o.grid = level_named(next());
+      else if (a == "--case") o.scase = case_named(next());
+      else if (a == "--mach-min") o.mach_min = std::stod(next());
+      else if (a == "--mach-max") o.mach_max = std::stod(next());
+      else if (a == "--out") o.out = next();
+      else if (a == "--fill") o.fill = std::stoi(next());
+      else if (a == "--max-points") o.max_points = std::stoi(next());
+      else throw input_error("unknown option " + a);
+    }
+    require(o.mach_min < o.mach_max, "--mach-min must be below --mach-max");
+    const grid_level& g = o.grid;
+    const structural_case& c = o.scase;
+    const double m0 = o.mach_min;
+
+    const auto s0 = make_system(g, m0, c.mu_s);
+    const steady_result st0 = steady(s0);
+    std::printf("%s case (mu_s = %g), %s grid (%ld unknowns), M = %.4f .. %.4f; steady solve from the free stream at "
+                "M = %.4f: %.3f s\n",
+                c.name.c_str(), c.mu_s, g.name.c_str(), static_cast<long>(s0.size()), m0, o.mach_max, m0, st0.seconds);
+    hopf_point guess = hopf_start(s0, st0.w, c.ubar_guess, c.omega_guess);
+    guess.mu = c.ubar_guess;
+
+    auto family = [&](double mach) { return make_system(g, mach, c.mu_s); };
+    hopf_curve_options ho;
+    ho.mu_scale = 0.5;
+    ho.nu_scale = 0.05;
+    ho.omega_scale = 0.05;
+    ho.step = 0.5;
+    ho.max_step = 1.0;
+    ho.min_step = 1e-3;
+    ho.nu_min = m0 - 1e-9;
+    ho.nu_max = o.mach_max;
+    ho.mu_min = 0.2;
+    ho.mu_max = 20.0;
+    ho.max_points = o.max_points;
+    ho.fast_iterations = 4;
+    for (int k = static_cast<int>(std::ceil(m0 * 100 + 1e-6)); k <= static_cast<int>(std::floor(o.mach_max * 100 + 1e-6)); ++k)
+      ho.nu_targets.push_back(k / 100.0);
+    ho.throw_on_failure = false;
+    ho.label = c.name + " " + g.name;
+    ho.verbose = true;
+    ho.start.newton.max_iterations = 20;
+    symmetric_hopf_curve_options so;
+    so.fill_level = o.fill;
+    csv_writer csv(o.out / ("hopf_curve_sym_" + c.name + "_" + g.name + ".csv"),
+                   "mach,ubar,omega,newton_iterations,linear_iterations,step,seconds,landed");
+    so.observer = [&](const hopf_curve_point& p, const symmetric_hopf_curve_stats& s) {
+      // Ubar enters only through 1/Ubar^2 (spec 05): -Ubar is the same point; report |Ubar|
+      csv.row({p.nu, std::abs(p.mu), p.omega, static_cast<long long>(p.newton_iterations),
+               static_cast<long long>(s.linear_iterations), p.step, p.seconds, static_cast<long long>(p.landed)});
+    };
+    const auto r = trace_symmetric_hopf_curve<4>(family, m0, guess, ho, +1, so);
+
+    // ---- summary ----
+    const auto& pts = r.points;
+    std::printf("\n%zu points, stop: %s\n%d failed correctors, %ld GMRES iterations (Hopf system), %d nested steady "
+                "solves (%.1f s), total %.1f s\n",
+                pts.size(), r.stop_reason.c_str(), r.failed_correctors, r.linear_iterations, r.steady_solves,
+                r.steady_seconds, r.seconds);
+    if (!r.missed_targets.empty()) {
+      std::printf("missed Mach targets:");
+      for (double m : r.missed_targets) std::printf(" %.4f", m);
+      std::printf("\n");
+    }
+    int turns = 0;
+    for (std::size_t k = 1; k + 1 < pts.size(); ++k) {
+      const double a = pts[k].nu - pts[k - 1].nu, b = pts[k + 1].nu - pts[k].nu;
+      if (a * b < 0) {
+        ++turns;
+        const double m[3] = {pts[k - 1].nu, pts[k].nu, pts[k + 1].nu};
+        const double u[3] = {std::abs(pts[k - 1].mu), std::abs(pts[k].mu), std::abs(pts[k + 1].mu)};
+        const auto [mv, uv] = parabola_vertex(m, u);
+        std::printf("turning point in M (%s): point %zu M = %.6f Ubar = %.5f omega = %.5f; parabola vertex M = %.6f "
+                    "Ubar = %.5f\n",
+                    a > 0 ? "maximum" : "minimum", k, pts[k].nu, std::abs(pts[k].mu), pts[k].omega, mv, uv);
+      }
+      const double ua = std::abs(pts[k].mu) - std::abs(pts[k - 1].mu), ub = std::abs(pts[k + 1].mu) - std::abs(pts[k].mu);
+      if (ua * ub < 0)
+        std::printf("extremum of Ubar (%s): point %zu M = %.6f Ubar = %.5f omega = %.5f\n", ua > 0 ? "maximum" : "minimum",
+                    k, pts[k].nu, std::abs(pts[k].mu), pts[k].omega);
+    }
+    std::printf("turning points in M: %d\n", turns);
+    double secs = 0, steady_secs = 0;
+    long lin = 0;
+    int steadies = 0;
+    for (std::size_t k = 1; k < pts.size(); ++k) {
+      secs += pts[k].seconds;
+      steady_secs += r.stats[k].steady_seconds;
+      lin += r.stats[k].linear_iterations;
+      steadies += r.stats[k].steady_solves;
+    }
+    if (pts.size() > 1) {
+      const double np = static_cast<double>(pts.size() - 1);
+      std::printf("per point (after the start, including failed attempts): %.3f s = %.2f steady solves from the free "
+                  "stream (%.3f s); %.1f GMRES iterations, %.1f nested steady solves (%.3f s)\n",
+                  secs / np, secs / np / st0.seconds, st0.seconds, lin / np, steadies / np, steady_secs / np);
+    }
+    std::printf("curve: %s\n", csv.path().string().c_str());
+    return r.stop == hopf_curve_stop::step_failure ? 2 : 0;
+  } catch (const std::exception& e) {
+    std::cerr << "aerofoil_branch: " << e.what() << "\n";
+    return 1;
+  }
+}

@@ -1,0 +1,684 @@
+#pragma once
+// Pseudo-arclength continuation of the SYMMETRIC Hopf curve with Krylov linear algebra: the
+// flutter boundary Ubar(M) of a symmetric aerofoil traced through its steep transonic branches
+// at a cost close to a steady solve per point, for grids where the full (3n+3) system of
+// hopf_curve.hpp (sparse LU, w as unknowns) costs a minute per point.
+//
+// Setting: a family S(nu) (nu = Mach number) whose equilibrium w0(nu) does NOT depend on the
+// system's parameter mu (Ubar: the structure is at rest, K(Ubar) w_s = 0) but does depend on nu.
+// The flow is then not an unknown of the Hopf system: it is the solution of a NESTED steady
+// solve at every nu the corrector visits, and the curve is traced in the unknowns
+//     X = [p_r, p_i, mu, nu, omega]                                   (2n + 3)
+// with the equations
+//     G(X) = [ A(nu, mu) p_r + omega p_i            A(nu, mu) = f_w(w0(nu), mu; nu)
+//              A(nu, mu) p_i - omega p_r
+//              s.p_r
+//              s.p_i - 1
+//              c.(y - y_pred) ]                     y = (mu, nu, omega),  c_j = t_j / sigma_j^2
+// (the symmetric Hopf system of hopf_bordered.hpp at w = w0(nu), plus the pseudo-arclength row
+// in the scaled (mu, nu, omega) metric of hopf_curve.hpp). A p is evaluated exactly and matrix-
+// free (jacobian_product: a taylor pass through the residual), so every point satisfies the
+// exact equations to the Newton tolerance, whatever the approximations below.
+//
+// Nested steady solve (w0(nu)): Newton on f(w, mu; nu) = 0 with the exact Jacobian as the GMRES
+// operator, right-preconditioned by the real BILU(k) of lhs_jacobian (the modified-order
+// Jacobian for the aerofoil: BILU of the exact second-order flow Jacobian is poor, spec 05),
+// factorised once per steady solve; inexact-Newton forcing eta = min(eta_max, ||f||) and
+// convergence at ||f||_2 <= steady.abs_tolerance (default 1e-11) or a full step at the rounding
+// floor (newton_options::step_tolerance). Warm start w0(nu_e) + (nu - nu_e) dw0/dnu(nu_e) from the
+// nearest nu_e already solved. Failure (no convergence, a non-physical state thrown by the
+// model, a GMRES failure) is a convergence_error naming nu; inside the trace it counts as a
+// failed corrector, so the step is halved. Solved equilibria are cached by nu (the corrector
+// revisits the same nu in the residual and the Jacobian).
+//     dw0/dnu = -f_w^{-1} f_nu,   f_nu = (f(w0, mu; nu + h) - f(w0, mu; nu - h)) / 2h
+// (GMRES with the same preconditioner, relative tolerance tangent_tolerance), once per nu.
+//
+// Jacobian of G (never needed exactly: it sets the convergence rate only):
+//     J = [ A         omega I   A_mu p_r   G_nu,r   p_i
+//          -omega I   A         A_mu p_i   G_nu,i  -p_r
+//           s^T       0         0          0        0
+//           0         s^T       0          0        0
+//           0         0         c_mu       c_nu     c_omega ]
+// with the column G_nu = d/dnu [A(w0(nu), mu; nu) p] INCLUDING the change of the equilibrium, by
+// central differences with the equilibrium extrapolated linearly:
+//     G_nu ~ (A(w0 + h w0', mu; nu + h) p - A(w0 - h w0', mu; nu - h) p) / 2h,   w0' = dw0/dnu.
+// This is exact to O(h^2): w0(nu +- h) = w0 +- h w0' + h^2/2 w0'' + O(h^3), and the h^2 terms
+// cancel in the central difference, so only w0' (not w0'') enters the first derivative and no
+// steady solves at nu +- h are needed. h = nu_step or cbrt(eps) max(1, |nu|).
+//
+// Linear solves: right-preconditioned GMRES on the WHOLE bordered matrix J (the real 2n block
+// applied as two SpMVs with the assembled exact Jacobian, three border unknowns mu, nu, omega,
+// two normalisation rows and the arclength row), preconditioned by bordered_preconditioner
+// (block elimination of the 3 x 3 border, linalg/block_sparse_matrix.hpp) around the complex
+// BILU(k) of the modified-order L - i omega I. NOT Keller block elimination with the fixed-nu
+// Hopf Jacobian (the (2n+2) matrix of solve_hopf_krylov): that matrix is singular exactly where
+// the curve turns in nu (dnu/ds = 0), which are the steep branches this tracer is for; J is not.
+// The same solve with the right-hand side e_last gives the exact tangent (the first predictor
+// and the retry after a failed secant step). GMRES uses the inexact-Newton forcing of
+// solve_hopf_krylov: eta = min(eta_max, max(||G||, 0.1 abs_tolerance / ||G||)).
+//
+// Cost per corrector iteration: one steady Newton solve at the new nu (1-3 iterations from the
+// linear extrapolation), one dw0/dnu solve, assembly of A, L, A_mu, one complex BILU(k), four
+// taylor products for G_nu, one GMRES on J.
+//
+// Everything else mirrors hopf_curve.hpp and uses its option and result types: metric and
+// step control (halve on failure, grow after <= fast_iterations, clamp), retry along the exact
+// tangent after a failed secant step, the sheet-jump guard (corrector_distance, min_cosine),
+// stops (max_points, nu/mu bounds landed exactly, Bogdanov-Takens, closed curve), landing on
+// nu_targets, observer per accepted point, throw_on_failure = false. opt.start (hopf_options)
+// converges the start at nu0 with solve_hopf_krylov (symmetric forced). Per-point costs (GMRES
+// iterations, steady solves) are returned alongside in symmetric_hopf_curve_result::stats.
+#include <Eigen/Core>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <complex>
+#include <functional>
+#include <iomanip>
+#include <iostream>
+#include <limits>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "../error.hpp"
+#include "../linalg/block_ilu.hpp"
+#include "../linalg/block_sparse_matrix.hpp"
+#include "../linalg/krylov.hpp"
+#include "../nonlinear/newton.hpp"
+#include "../nonlinear/system.hpp"
+#include "hopf.hpp"
+#include "hopf_bordered.hpp"
+#include "hopf_curve.hpp"
+#include "hopf_point.hpp"
+
+namespace aerohopf {
+
+/// Costs of one accepted point of the symmetric tracer (parallel to hopf_curve_result::points).
+struct symmetric_hopf_curve_stats {
+  long linear_iterations = 0;   ///< GMRES iterations of the corrector(s) and tangents (Hopf system)
+  int steady_solves = 0;        ///< nested steady Newton solves (new nu values)
+  int steady_iterations = 0;    ///< their Newton iterations
+  long steady_linear_iterations = 0;  ///< their GMRES iterations (and those of dw0/dnu)
+  double steady_seconds = 0;    ///< wall time in the nested steady solves and dw0/dnu
+};
+
+struct symmetric_hopf_curve_result : hopf_curve_result {
+  std::vector<symmetric_hopf_curve_stats> stats;  ///< one per point, including failed attempts
+  long linear_iterations = 0;
+  int steady_solves = 0;
+  double steady_seconds = 0;
+};
+
+/// Linear algebra and nested steady solves of trace_symmetric_hopf_curve (the curve options
+/// are those of hopf_curve_options).
+struct symmetric_hopf_curve_options {
+  int fill_level = 1;  ///< k of the complex BILU(k) of L - i omega I and of the real BILU(k) of L
+  krylov_options krylov = [] {
+    krylov_options o;
+    o.relative_tolerance = 1e-6;  ///< when not adaptive
+    o.max_iterations = 2000;
+    o.restart = 80;
+    o.record_history = false;
+    return o;
+  }();
+  bool adaptive_tolerance = true;   ///< inexact-Newton forcing (file comment)
+  double eta_max = 1e-2;
+  double tangent_tolerance = 1e-8;  ///< relative GMRES tolerance of tangents and dw0/dnu
+  newton_options steady = [] {
+    newton_options o;
+    o.abs_tolerance = 1e-11;  ///< on ||f(w, mu; nu)||_2
+    o.max_iterations = 12;
+    return o;
+  }();                              ///< nested steady Newton (throw_on_failure is ignored)
+  std::size_t equilibrium_cache = 8;  ///< solved equilibria kept (by nu)
+  /// Called for every accepted point with its costs (after hopf_curve_options::observer).
+  std::function<void(const hopf_curve_point&, const symmetric_hopf_curve_stats&)> observer;
+};
+
+/// Traces the symmetric Hopf curve of family(nu) through the Hopf point `start` of family(nu0)
+/// (a guess: start.w an approximate equilibrium at nu0, polished by the nested steady Newton;
+/// then (p, mu, omega) converged by solve_hopf_krylov<B> at fixed nu0), initially towards
+/// increasing (direction = +1) or decreasing (-1) nu. B: block size of the unknowns for BILU
+/// (4 for 2D Euler + pitch-plunge). See the file comment.
+template <int B, system_family F>
+  requires is_sparse_matrix_v<jacobian_t<family_system_t<F>>>
+symmetric_hopf_curve_result trace_symmetric_hopf_curve(const F& family, double nu0, const hopf_point& start,
+                                                       const hopf_curve_options& opt = {}, int direction = +1,
+                                                       const symmetric_hopf_curve_options& sopt = {}) {
+  using S = family_system_t<F>;
+  using M = jacobian_t<S>;
+  using C = std::complex<double>;
+  using clock = std::chrono::steady_clock;
+  using real_block = block_sparse_matrix<double, B>;
+  const std::string& lab = opt.label;
+  const auto t_begin = clock::now();
+  require(std::isfinite(nu0), lab, ": nu0 is not finite");
+  require(opt.step > 0 && opt.min_step > 0 && opt.max_step >= opt.min_step && opt.step >= opt.min_step,
+          lab, ": bad step sizes (step ", opt.step, ", min ", opt.min_step, ", max ", opt.max_step, ")");
+  require(opt.mu_scale > 0 && opt.nu_scale > 0 && opt.omega_scale >= 0, lab, ": metric scales must be positive");
+  require(opt.growth >= 1, lab, ": growth must be >= 1");
+  require(nu0 >= opt.nu_min && nu0 <= opt.nu_max, lab, ": nu0 = ", nu0, " outside [nu_min, nu_max]");
+  require(direction == 1 || direction == -1, lab, ": direction must be +1 or -1");
+  require(sopt.fill_level >= 0, lab, ": fill level ", sopt.fill_level, " < 0");
+  require(sopt.eta_max > 0 && sopt.eta_max < 1 && sopt.tangent_tolerance > 0 && sopt.tangent_tolerance < 1, lab,
+          ": GMRES tolerances must lie in (0, 1) (eta_max ", sopt.eta_max, ", tangent ", sopt.tangent_tolerance, ")");
+  require(sopt.steady.abs_tolerance > 0 && sopt.steady.max_iterations >= 1, lab,
+          ": nested steady Newton needs abs_tolerance > 0 and max_iterations >= 1");
+  require(std::isfinite(start.mu) && std::isfinite(start.omega), lab, ": start mu or omega is not finite");
+
+  symmetric_hopf_curve_result res;
+  symmetric_hopf_curve_stats acc;  // costs since the last accepted point
+  internal::family_cache<F, S> cur(family), plus(family), minus(family);
+  Eigen::Index n = 0;
+  {
+    const S& s0 = cur.at(nu0);
+    n = s0.size();
+  }
+  require(n > 0, lab, ": family(nu0) has no unknowns");
+  require(start.w.size() == n, lab, ": start state has ", start.w.size(), " entries, family(nu0) ", n);
+  require(start.p.size() == n, lab, ": start eigenvector has ", start.p.size(), " entries, family(nu0) ", n);
+  const Eigen::Index padded = padded_block_count(n, B) * B;
+  const Eigen::Index N = 2 * n + 3, ipr = 0, ipi = n, imu = 2 * n, inu = 2 * n + 1, iom = 2 * n + 2;
+  const hopf_normalisation mode = resolve_normalisation<M>(opt.normalisation);
+  const double sig[3] = {opt.mu_scale, opt.nu_scale, opt.omega_scale};
+  auto yv = [&](const vec<double>& x, int j) { return x[imu + j]; };
+  auto ydot = [&](const vec<double>& a, const vec<double>& b) {
+    double d = 0;
+    for (int j = 0; j < 3; ++j)
+      if (sig[j] > 0) d += yv(a, j) * yv(b, j) / (sig[j] * sig[j]);
+    return d;
+  };
+  auto ydist = [&](const vec<double>& a, const vec<double>& b) {
+    const vec<double> d = a - b;
+    return std::sqrt(ydot(d, d));
+  };
+  auto get_p = [&](const vec<double>& x) {
+    vec<C> p(n);
+    p.real() = x.segment(ipr, n);
+    p.imag() = x.segment(ipi, n);
+    return p;
+  };
+  auto set_p = [&](vec<double>& x, const vec<C>& p) {
+    x.segment(ipr, n) = p.real();
+    x.segment(ipi, n) = p.imag();
+  };
+  auto rescale_p = [&](vec<double>& x, const vec<double>& s) {
+    vec<C> p = get_p(x);
+    const C sp = s.template cast<C>().dot(p);
+    require(std::abs(sp) > 0, lab, ": eigenvector orthogonal to the normalisation vector");
+    p *= C(0, 1) / sp;
+    set_p(x, p);
+  };
+  auto refresh_s = [&](vec<double>& x) {
+    vec<C> p = get_p(x);
+    vec<double> s = hopf_normalise(p, mode);
+    set_p(x, p);
+    return s;
+  };
+  auto nu_h = [&](double nu) {
+    return opt.nu_step > 0 ? opt.nu_step : std::cbrt(Eigen::NumTraits<double>::epsilon()) * std::max(1.0, std::abs(nu));
+  };
+  auto system_at = [&](internal::family_cache<F, S>& cache, double nu) -> const S& {
+    const S& s = cache.at(nu);
+    require(s.size() == n, lab, ": family(", nu, ") has ", s.size(), " unknowns, family(nu0) ", n);
+    return s;
+  };
+  auto pad = [&](const vec<double>& v) {
+    vec<double> r = vec<double>::Zero(padded);
+    r.head(n) = v;
+    return r;
+  };
+  auto blocked = [&](const M& m) { return real_block::from_sparse(m, B); };
+
+  // ---- nested steady solves, cached by nu ----
+  struct equilibrium {
+    double nu;
+    vec<double> w, dw;  // w0(nu), dw0/dnu (empty until needed)
+  };
+  std::vector<equilibrium> cache;
+  block_ilu_options rio;
+  rio.fill_level = sopt.fill_level;
+  rio.context = lab + ": real BILU(" + std::to_string(sopt.fill_level) + ") of the steady Newton matrix";
+  block_ilu<double, B> rilu(rio);
+  auto gmres_real = [&](const real_block& a, const vec<double>& rhs, double tol, const std::string& what) {
+    krylov_options ko = sopt.krylov;
+    ko.relative_tolerance = tol;
+    ko.throw_on_failure = true;
+    ko.context = what;
+    vec<double> xp = vec<double>::Zero(padded);
+    const krylov_report rep = gmres<double>(a, rilu, pad(rhs), xp, ko);
+    acc.steady_linear_iterations += rep.iterations;
+    return vec<double>(xp.head(n));
+  };
+  // Newton on f(w, mu; nu) = 0 from w (file comment); throws convergence_error naming nu.
+  auto steady_solve = [&](double nu, double mu, vec<double> w) -> vec<double> {
+    const auto t0 = clock::now();
+    const std::string what = internal::concat(lab, ": steady state at nu = ", nu);
+    try {
+      const S& sys = system_at(cur, nu);
+      newton_options no = sopt.steady;
+      no.throw_on_failure = true;
+      no.observer = nullptr;
+      real_block a;
+      newton_result nr = newton_iterate(
+          [&](const vec<double>& v) { return vec<double>(sys.residual(v, mu)); },
+          [&](const vec<double>& v, const vec<double>& f, int k) {
+            a = blocked(sys.jacobian(v, mu));
+            if (k == 1) rilu.compute(blocked(lhs_jacobian(sys, v, mu)));
+            const double fn = f.norm();
+            const double eta = std::min(sopt.eta_max, std::max(fn, 0.1 * sopt.steady.abs_tolerance / fn));
+            return vec<double>(gmres_real(a, vec<double>(-f), std::min(eta, 0.5), what + ", GMRES"));
+          },
+          std::move(w), no, what);
+      acc.steady_solves += 1;
+      acc.steady_iterations += nr.report.iterations;
+      acc.steady_seconds += std::chrono::duration<double>(clock::now() - t0).count();
+      return std::move(nr.x);
+    } catch (const convergence_error&) {
+      acc.steady_seconds += std::chrono::duration<double>(clock::now() - t0).count();
+      throw;
+    } catch (const error& e) {  // e.g. a non-physical state or a singular pivot: a failed solve
+      acc.steady_seconds += std::chrono::duration<double>(clock::now() - t0).count();
+      throw convergence_error(what + ": " + e.what());
+    }
+  };
+  auto find_equilibrium = [&](double nu) -> equilibrium* {
+    for (auto& e : cache)
+      if (e.nu == nu) return &e;
+    return nullptr;
+  };
+  // dw0/dnu = -f_w^{-1} f_nu at a solved equilibrium (f_w = a, preconditioner BILU of lb).
+  auto ensure_derivative = [&](equilibrium& e, double mu, const real_block& a, const real_block& lb) {
+    if (e.dw.size() == n) return;
+    const auto t0 = clock::now();
+    const double h = nu_h(e.nu);
+    const S& sp = system_at(plus, e.nu + h);
+    const S& sm = system_at(minus, e.nu - h);
+    const vec<double> f_nu = (vec<double>(sp.residual(e.w, mu)) - vec<double>(sm.residual(e.w, mu))) / (2 * h);
+    rilu.compute(lb);
+    e.dw = gmres_real(a, vec<double>(-f_nu), sopt.tangent_tolerance,
+                      internal::concat(lab, ": dw0/dnu at nu = ", e.nu, ", GMRES"));
+    acc.steady_seconds += std::chrono::duration<double>(clock::now() - t0).count();
+  };
+  internal::family_cache<F, S> aux(family);  // for dw0/dnu at a cached nu other than the current one
+  // w0(nu) (solved if not cached), warm-started from the nearest cached nu along its dw0/dnu.
+  auto equilibrium_at = [&](double nu, double mu) -> equilibrium& {
+    if (equilibrium* e = find_equilibrium(nu)) return *e;
+    require(!cache.empty(), lab, ": no equilibrium to start the steady solve at nu = ", nu, " from");
+    equilibrium* best = &cache.front();
+    for (auto& e : cache)
+      if (std::abs(e.nu - nu) < std::abs(best->nu - nu)) best = &e;
+    if (best->dw.size() != n) {
+      const S& sb = system_at(aux, best->nu);
+      ensure_derivative(*best, mu, blocked(sb.jacobian(best->w, mu)), blocked(lhs_jacobian(sb, best->w, mu)));
+    }
+    vec<double> w = steady_solve(nu, mu, vec<double>(best->w + (nu - best->nu) * best->dw));
+    if (cache.size() >= std::max<std::size_t>(sopt.equilibrium_cache, 2)) cache.erase(cache.begin());
+    cache.push_back({nu, std::move(w), vec<double>()});
+    return cache.back();
+  };
+
+  // ---- the Hopf residual and the bordered linear solves ----
+  auto residual = [&](const vec<double>& x, const vec<double>& s, const double* c, double value) {
+    const double mu = x[imu], nu = x[inu], om = x[iom];
+    const vec<double>& w = equilibrium_at(nu, mu).w;
+    const S& sys = system_at(cur, nu);
+    const vec<double> pr = x.segment(ipr, n), pi = x.segment(ipi, n);
+    vec<double> f(N);
+    f.segment(ipr, n) = jacobian_product(sys, w, mu, pr) + om * pi;
+    f.segment(ipi, n) = jacobian_product(sys, w, mu, pi) - om * pr;
+    f[imu] = s.dot(pr);
+    f[inu] = s.dot(pi) - 1.0;
+    f[iom] = c[0] * x[imu] + c[1] * x[inu] + c[2] * x[iom] - value;
+    return f;
+  };
+  block_ilu_options cio;
+  cio.fill_level = sopt.fill_level;
+  cio.context = lab + ": complex BILU(" + std::to_string(sopt.fill_level) + ") of L - i omega I";
+  block_ilu<C, B> cilu(cio);
+  // Solves J(x) dx = rhs (J with the last row c) by GMRES with the bordered complex-BILU
+  // preconditioner; throws convergence_error / singular_matrix_error.
+  auto solve_bordered = [&](const vec<double>& x, const vec<double>& s, const double* c, const vec<double>& rhs,
+                            double tol, const std::string& what) {
+    const double mu = x[imu], nu = x[inu], om = x[iom];
+    equilibrium& e = equilibrium_at(nu, mu);
+    const vec<double>& w = e.w;
+    const S& sys = system_at(cur, nu);
+    const vec<double> pr = x.segment(ipr, n), pi = x.segment(ipi, n);
+    const real_block a = blocked(sys.jacobian(w, mu));
+    const real_block lb = blocked(lhs_jacobian(sys, w, mu));
+    ensure_derivative(e, mu, a, lb);
+    const M amu = jacobian_d_mu(sys, w, mu);
+    // G_nu by central differences along the linearly extrapolated equilibrium (file comment)
+    const double h = nu_h(nu);
+    const S& sp = system_at(plus, nu + h);
+    const S& sm = system_at(minus, nu - h);
+    const vec<double> wp = w + h * e.dw, wm = w - h * e.dw;
+    const vec<double> gr = (jacobian_product(sp, wp, mu, pr) - jacobian_product(sm, wm, mu, pr)) / (2 * h);
+    const vec<double> gi = (jacobian_product(sp, wp, mu, pi) - jacobian_product(sm, wm, mu, pi)) / (2 * h);
+    cilu.compute(shifted(lb, C(0.0, om)));
+    vec<double> xin = vec<double>::Zero(padded), xout(padded);
+    auto inner = [&](const vec<double>& v, vec<double>& r) {
+      xin.head(n) = v.head(n);
+      a.multiply(xin, xout);
+      r.head(n) = xout.head(n);
+      xin.head(n) = v.tail(n);
+      a.multiply(xin, xout);
+      r.tail(n) = xout.head(n);
+      r.head(n) += om * v.tail(n);
+      r.tail(n) -= om * v.head(n);
+    };
+    vec<C> rc = vec<C>::Zero(padded), zc(padded);
+    auto inner_pre = [&](const vec<double>& r, vec<double>& z) {
+      rc.head(n).real() = r.head(n);
+      rc.head(n).imag() = r.tail(n);
+      cilu.apply(rc, zc);
+      z.head(n) = zc.head(n).real();
+      z.tail(n) = zc.head(n).imag();
+    };
+    Eigen::MatrixXd u(2 * n, 3), vt = Eigen::MatrixXd::Zero(3, 2 * n), d = Eigen::MatrixXd::Zero(3, 3);
+    u.col(0) << amu * pr, amu * pi;
+    u.col(1) << gr, gi;
+    u.col(2) << pi, -pr;
+    vt.row(0).head(n) = s.transpose();
+    vt.row(1).tail(n) = s.transpose();
+    for (int k = 0; k < 3; ++k) d(2, k) = c[k];
+    const bordered_operator<decltype(inner), double> jop(inner, 2 * n, std::move(u), std::move(vt), std::move(d));
+    const bordered_preconditioner<decltype(inner_pre), double> jpre(jop, inner_pre);
+    krylov_options ko = sopt.krylov;
+    ko.relative_tolerance = tol;
+    ko.context = what;
+    ko.throw_on_failure = true;
+    vec<double> dx = vec<double>::Zero(N);
+    const krylov_report rep = gmres<double>(jop, jpre, rhs, dx, ko);
+    acc.linear_iterations += rep.iterations;
+    return dx;
+  };
+
+  struct corrected {
+    vec<double> x;
+    int iterations = 0;
+  };
+  std::string last_failure;
+  auto correct = [&](const vec<double>& x0, const vec<double>& s, const double* c,
+                     double value) -> std::optional<corrected> {
+    newton_options no = opt.newton;
+    no.throw_on_failure = true;
+    try {
+      newton_result nr = newton_iterate(
+          [&](const vec<double>& x) { return residual(x, s, c, value); },
+          [&](const vec<double>& x, const vec<double>& f, int it) {
+            const double fn = f.norm();
+            double tol = sopt.krylov.relative_tolerance;
+            if (sopt.adaptive_tolerance) tol = std::min(sopt.eta_max, std::max(fn, 0.1 * no.abs_tolerance / fn));
+            return vec<double>(solve_bordered(x, s, c, vec<double>(-f), std::min(tol, 0.5),
+                                              internal::concat(lab, ": GMRES at corrector iteration ", it)));
+          },
+          x0, no, lab + " corrector");
+      if (!nr.x.allFinite()) {
+        last_failure = "corrector returned a non-finite point";
+        return std::nullopt;
+      }
+      return corrected{std::move(nr.x), nr.report.iterations};
+    } catch (const error& e) {
+      last_failure = e.what();
+      return std::nullopt;
+    }
+  };
+
+  auto make_point = [&](const vec<double>& x, int iters, int attempts, double step, double secs, bool landed) {
+    hopf_curve_point pt;
+    pt.w = equilibrium_at(x[inu], x[imu]).w;  // cached: the corrector's last residual was at this nu
+    pt.p = get_p(x);
+    pt.mu = x[imu];
+    pt.nu = x[inu];
+    pt.omega = x[iom];
+    pt.newton_iterations = iters;
+    pt.attempts = attempts;
+    pt.step = step;
+    pt.seconds = secs;
+    pt.landed = landed;
+    return pt;
+  };
+  auto emit = [&](hopf_curve_point pt) {
+    if (opt.verbose && opt.log)
+      *opt.log << lab << " " << std::setw(4) << res.points.size() << "  nu " << std::setprecision(10) << pt.nu
+               << "  mu " << pt.mu << "  omega " << pt.omega << "  newton " << pt.newton_iterations << "  gmres "
+               << acc.linear_iterations << "  steady " << acc.steady_solves << " (" << acc.steady_iterations
+               << " its)  step " << std::setprecision(4) << pt.step << "  " << std::setprecision(3) << pt.seconds << " s"
+               << (pt.attempts > 1 ? "  (" + std::to_string(pt.attempts - 1) + " retries)" : "")
+               << (pt.landed ? "  (landed)" : "") << std::setprecision(6) << std::endl;
+    if (opt.observer) opt.observer(pt);
+    if (sopt.observer) sopt.observer(pt, acc);
+    res.linear_iterations += acc.linear_iterations;
+    res.steady_solves += acc.steady_solves;
+    res.steady_seconds += acc.steady_seconds;
+    res.stats.push_back(acc);
+    acc = {};
+    res.points.push_back(std::move(pt));
+  };
+  auto finish = [&](hopf_curve_stop why, std::string reason) {
+    res.stop = why;
+    res.stop_reason = std::move(reason);
+    res.seconds = std::chrono::duration<double>(clock::now() - t_begin).count();
+    if (opt.verbose && opt.log) *opt.log << lab << ": stop: " << res.stop_reason << std::endl;
+    return res;
+  };
+  auto seconds_since = [](clock::time_point t) { return std::chrono::duration<double>(clock::now() - t).count(); };
+
+  // ---- the start: equilibrium at nu0, then the symmetric Hopf point there ----
+  const auto t_start = clock::now();
+  hopf_result h0;
+  {
+    check_state(system_at(cur, nu0), start.w, start.mu, "trace_symmetric_hopf_curve");
+    vec<double> w0 = steady_solve(nu0, start.mu, start.w);
+    cache.push_back({nu0, w0, vec<double>()});
+    hopf_point g = start;
+    g.w = std::move(w0);
+    hopf_options ho = opt.start;
+    ho.symmetric = true;
+    ho.normalisation = opt.normalisation;
+    ho.label = lab + ": start point at nu = " + internal::concat(nu0);
+    hopf_krylov_options ko;
+    ko.fill_level = sopt.fill_level;
+    h0 = solve_hopf_krylov<B>(system_at(cur, nu0), g, ho, ko);
+    require(h0.report.converged, lab, ": start point at nu = ", nu0, " did not converge (", h0.report.reason, ")");
+    acc.linear_iterations += h0.linear_iterations;
+  }
+  require(h0.point.omega > opt.omega_min, lab, ": start point has omega = ", h0.point.omega,
+          " <= omega_min (not a Hopf point)");
+  vec<double> x(N);
+  set_p(x, h0.point.p);
+  x[imu] = h0.point.mu;
+  x[inu] = nu0;
+  x[iom] = h0.point.omega;
+  vec<double> s = refresh_s(x);
+
+  // Exact tangent at x: J t = e_last with the last row c, normalised in the metric.
+  auto exact_tangent = [&](const vec<double>& xx, const vec<double>& ss, const double* c) {
+    vec<double> e = vec<double>::Zero(N);
+    e[iom] = 1;
+    vec<double> tt = solve_bordered(xx, ss, c, e, sopt.tangent_tolerance, lab + ": GMRES for the tangent");
+    const double tn = std::sqrt(ydot(tt, tt));
+    if (!(std::isfinite(tn) && tn > 0)) throw singular_matrix_error(lab + ": tangent is not finite");
+    return vec<double>(tt / tn);
+  };
+  vec<double> t;
+  {
+    const double c_nu[3] = {0, 1, 0};
+    try {
+      t = exact_tangent(x, s, c_nu);
+    } catch (const error& e) {
+      throw convergence_error(internal::concat(lab, ": no tangent dX/dnu at the start (nu = ", nu0, ", mu = ", x[imu],
+                                               "): a turning point of the curve in nu or a degenerate Hopf point? ",
+                                               e.what()));
+    }
+    if (t[inu] * direction < 0) t = -t;
+  }
+  emit(make_point(x, h0.report.iterations, 1, 0.0, seconds_since(t_start), false));
+  if (res.points.size() >= size_t(opt.max_points)) return finish(hopf_curve_stop::max_points, "max_points reached");
+
+  struct landing {
+    int row;  // 0: mu, 1: nu
+    double value;
+    bool bound;
+  };
+  std::vector<landing> lands;
+  for (double v : opt.nu_targets) lands.push_back({1, v, false});
+  if (std::isfinite(opt.nu_min)) lands.push_back({1, opt.nu_min, true});
+  if (std::isfinite(opt.nu_max)) lands.push_back({1, opt.nu_max, true});
+  if (std::isfinite(opt.mu_min)) lands.push_back({0, opt.mu_min, true});
+  if (std::isfinite(opt.mu_max)) lands.push_back({0, opt.mu_max, true});
+
+  const vec<double> x_first = x;
+  vec<double> x_prev;
+  double ds = std::min(opt.step, opt.max_step), arclength = 0;
+  for (;;) {
+    const auto t_point = clock::now();
+    int attempts = 0;
+    bool exact_t = false;
+    std::optional<corrected> xn;
+    for (;;) {
+      ++attempts;
+      const vec<double> xp = x + ds * t;
+      double c[3], value = 0;
+      for (int j = 0; j < 3; ++j) {
+        c[j] = sig[j] > 0 ? yv(t, j) / (sig[j] * sig[j]) : 0.0;
+        value += c[j] * yv(xp, j);
+      }
+      xn = correct(xp, s, c, value);
+      if (xn) {
+        const double moved = ydist(xn->x, xp);
+        const vec<double> d = xn->x - x;
+        const double dn = std::sqrt(ydot(d, d));
+        if (!(moved <= opt.corrector_distance * ds)) {
+          last_failure = internal::concat("corrector moved ", moved, " from the prediction (step ", ds, ")");
+          xn.reset();
+        } else if (!(ydot(d, t) > opt.min_cosine * dn)) {
+          last_failure = "the corrected point lies behind the last point or off the predicted direction";
+          xn.reset();
+        }
+      }
+      if (xn) break;
+      ++res.failed_correctors;
+      bool retry_same = false;
+      if (!exact_t && res.points.size() > 1) {
+        try {
+          double cc[3];
+          for (int j = 0; j < 3; ++j) cc[j] = sig[j] > 0 ? yv(t, j) / (sig[j] * sig[j]) : 0.0;
+          vec<double> te = exact_tangent(x, s, cc);
+          if (ydot(te, t) < 0) te = -te;
+          t = std::move(te);
+          retry_same = true;
+        } catch (const error& e) {
+          last_failure += internal::concat(" (exact tangent failed: ", e.what(), ")");
+        }
+        exact_t = true;
+      }
+      if (opt.verbose && opt.log)
+        *opt.log << lab << ": step " << ds << " from nu = " << x[inu] << ", mu = " << x[imu] << " failed ("
+                 << last_failure << "), " << (retry_same ? "retrying along the exact tangent" : "halving") << std::endl;
+      if (retry_same) continue;
+      ds *= 0.5;
+      if (ds < opt.min_step) {
+        const std::string why = internal::concat(
+            lab, ": step fell below min_step = ", opt.min_step, " after the point nu = ", x[inu], ", mu = ", x[imu],
+            ", omega = ", x[iom], " (point ", res.points.size() - 1, "); last attempted step ", 2 * ds,
+            ", last failure: ", last_failure);
+        if (opt.throw_on_failure) throw convergence_error(why);
+        return finish(hopf_curve_stop::step_failure, why);
+      }
+    }
+    vec<double> xnew = std::move(xn->x);
+    const int iters = xn->iterations;
+    const double step_seconds = seconds_since(t_point);
+    // costs of this step, kept apart from those of landings emitted before xnew
+    const symmetric_hopf_curve_stats step_costs = std::exchange(acc, symmetric_hopf_curve_stats{});
+    auto add_step_costs = [&] {
+      acc.linear_iterations += step_costs.linear_iterations;
+      acc.steady_solves += step_costs.steady_solves;
+      acc.steady_iterations += step_costs.steady_iterations;
+      acc.steady_linear_iterations += step_costs.steady_linear_iterations;
+      acc.steady_seconds += step_costs.steady_seconds;
+    };
+
+    // ---- Bogdanov-Takens: omega reaches zero ----
+    if (xnew[iom] <= opt.omega_min) {
+      std::vector<const vec<double>*> pts = {&x, &xnew};
+      if (x_prev.size()) pts.push_back(&x_prev);
+      double s1 = 0, sz = 0, szz = 0;
+      double sy[2] = {0, 0}, szy[2] = {0, 0};
+      for (const vec<double>* q : pts) {
+        const double z = (*q)[iom] * (*q)[iom];
+        s1 += 1, sz += z, szz += z * z;
+        for (int j = 0; j < 2; ++j) sy[j] += (*q)[imu + j], szy[j] += z * (*q)[imu + j];
+      }
+      const double det = s1 * szz - sz * sz;
+      for (int j = 0; j < 2; ++j) {
+        const double a = std::abs(det) > 1e-300 ? (szz * sy[j] - sz * szy[j]) / det : xnew[imu + j];
+        (j == 0 ? res.bogdanov_takens_mu : res.bogdanov_takens_nu) = a;
+      }
+      add_step_costs();
+      if (xnew[iom] > 0) emit(make_point(xnew, iters, attempts, ydist(xnew, x), step_seconds, false));
+      return finish(hopf_curve_stop::bogdanov_takens,
+                    internal::concat("omega -> 0: the Hopf curve ends at a Bogdanov-Takens point near nu = ",
+                                     res.bogdanov_takens_nu, ", mu = ", res.bogdanov_takens_mu, " (last omega ",
+                                     xnew[iom], ")"));
+    }
+
+    // ---- landings on targets and bounds crossed by this step, in curve order ----
+    std::vector<std::pair<double, landing>> crossed;
+    for (const auto& l : lands) {
+      const double a = x[imu + l.row] - l.value, b = xnew[imu + l.row] - l.value;
+      if (a * b < 0 || (b == 0 && a != 0)) crossed.push_back({a / (a - b), l});
+    }
+    std::sort(crossed.begin(), crossed.end(), [](const auto& u, const auto& v) { return u.first < v.first; });
+    for (const auto& [theta, l] : crossed) {
+      const auto t_land = clock::now();
+      const vec<double> x0 = x + theta * (xnew - x);
+      double c[3] = {0, 0, 0};
+      c[l.row] = 1;
+      auto xl = correct(x0, s, c, l.value);
+      if (xl) {
+        emit(make_point(xl->x, xl->iterations, 1, ydist(xl->x, x), seconds_since(t_land), true));
+      } else {
+        if (opt.verbose && opt.log)
+          *opt.log << lab << ": landing on " << (l.row ? "nu = " : "mu = ") << l.value << " failed: " << last_failure
+                   << std::endl;
+        if (!l.bound) res.missed_targets.push_back(l.value);
+      }
+      if (l.bound) {
+        if (!xl) {
+          add_step_costs();
+          emit(make_point(xnew, iters, attempts, ydist(xnew, x), step_seconds, false));
+        }
+        return finish(l.row ? hopf_curve_stop::nu_bounds : hopf_curve_stop::mu_bounds,
+                      internal::concat("reached ", l.row ? "nu = " : "mu = ", l.value,
+                                       xl ? "" : " (landing failed: the last point lies outside)"));
+      }
+      if (res.points.size() >= size_t(opt.max_points)) return finish(hopf_curve_stop::max_points, "max_points reached");
+    }
+
+    // ---- accept ----
+    const double len = ydist(xnew, x);
+    arclength += len;
+    add_step_costs();
+    emit(make_point(xnew, iters, attempts, len, step_seconds, false));
+    if (res.points.size() >= size_t(opt.max_points)) return finish(hopf_curve_stop::max_points, "max_points reached");
+    s = refresh_s(xnew);
+    x_prev = std::move(x);
+    rescale_p(x_prev, s);
+    t = xnew - x_prev;
+    t /= std::sqrt(ydot(t, t));
+    x = std::move(xnew);
+    if (opt.detect_closed && arclength > 3 * len && ydist(x, x_first) < len)
+      return finish(hopf_curve_stop::closed_curve,
+                    internal::concat("the curve closed on its start after arclength ", arclength));
+    if (iters <= opt.fast_iterations) ds = std::min(opt.max_step, opt.growth * ds);
+  }
+}
+
+}  // namespace aerohopf

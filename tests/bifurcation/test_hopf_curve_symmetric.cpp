@@ -1,0 +1,301 @@
+// The Krylov tracer of the symmetric Hopf curve with nested steady solves
+// (hopf_curve_symmetric.hpp), checked against independent references:
+//  * a synthetic family whose equilibrium w*(nu) depends on nu but not on mu and whose Hopf
+//    curve is the unit circle mu^2 + nu^2 = 1 (omega = 1 + 0.3 mu), so it turns in nu at nu = 1
+//    (dnu/ds = 0, where the fixed-nu Hopf Jacobian is singular): closed form, the dense spectrum
+//    at every point, and trace_hopf_curve (the full (3n+3) system with w as unknowns and a
+//    sparse LU: independent linear algebra) at the same landed points;
+//  * the heavy-case aerofoil (spec 05, mu_s = 100) on the very coarse grid from M = 0.78: the
+//    point landed on M = 0.79 against solve_hopf_krylov at M = 0.79 from an independent steady
+//    solve (solve_steady, pseudo-transient) and against the full-system tracer's value there;
+//  * bad input and a family that cannot be built past some nu (step failure reported).
+#include <aerohopf/bifurcation.hpp>
+#include <aerohopf/flow/naca_cgrid.hpp>
+#include <aerohopf/models/aerofoil.hpp>
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Dense>
+#include <Eigen/SparseCore>
+
+#include <chrono>
+#include <cmath>
+#include <complex>
+#include <iomanip>
+#include <iostream>
+
+using namespace aerohopf;
+
+namespace {
+
+/// dw/dt = T g(T^{-1} (w - w*(nu))) with g(0) = 0, g'(0) = block diag(B(mu, nu), -1, -2, ...),
+/// B = [[a, -b], [b, a]], a = 1 - mu^2 - nu^2, b = 1 + 0.3 mu: equilibrium w*(nu) for every mu,
+/// Hopf points on the unit circle in (mu, nu) with omega = b. Sparse Jacobian (the Krylov tracer
+/// needs one) and an approximate Jacobian A - 0.5 I (as the modified-order one of the aerofoil:
+/// L - i omega I stays regular at the Hopf point, the preconditioner is not exact).
+class circle_family_system {
+ public:
+  using jacobian_type = Eigen::SparseMatrix<double>;
+  static constexpr int n = 8;
+
+  explicit circle_family_system(double nu) : nu_(nu) {
+    t_.setZero(n, n);
+    for (int i = 0; i < n; ++i)
+      for (int j = 0; j < n; ++j)
+        if (std::abs(i - j) <= 2) t_(i, j) = (i == j ? 2.0 : 0.0) + 0.3 * std::sin(1.0 + i + 2.0 * j);
+    ti_ = t_.inverse();
+  }
+  Eigen::Index size() const { return n; }
+
+  vec<double> equilibrium() const {
+    vec<double> w(n);
+    for (int i = 0; i < n; ++i) w[i] = 0.5 * std::sin(nu_ + 0.3 * i) + std::cos(nu_ * (1.0 - 0.2 * i)) + 0.1 * i;
+    return w;
+  }
+
+  template <class T>
+  vec<T> residual(const vec<T>& w, const T& mu) const {
+    const vec<double> we = equilibrium();
+    vec<T> z(n);
+    for (int i = 0; i < n; ++i) {
+      z[i] = T(0.0);
+      for (int j = 0; j < n; ++j) z[i] += T(ti_(i, j)) * (w[j] - T(we[j]));
+    }
+    const T a = T(1.0) - mu * mu - T(nu_ * nu_), b = T(1.0) + T(0.3) * mu;
+    vec<T> g(n);
+    g[0] = a * z[0] - b * z[1] + T(0.5) * z[0] * z[0] - z[1] * z[2];
+    g[1] = b * z[0] + a * z[1] + z[0] * z[1] + T(0.3) * z[2] * z[2];
+    for (int j = 2; j < n; ++j) g[j] = -T(double(j - 1)) * z[j] + z[0] * z[0] - T(0.5) * z[0] * z[1];
+    vec<T> f(n);
+    for (int i = 0; i < n; ++i) {
+      f[i] = T(0.0);
+      for (int j = 0; j < n; ++j) f[i] += T(t_(i, j)) * g[j];
+    }
+    return f;
+  }
+  jacobian_type jacobian(const vec<double>& w, double mu) const {
+    Eigen::MatrixXd a(n, n);
+    for (int j = 0; j < n; ++j) a.col(j) = jacobian_product(*this, w, mu, vec<double>(vec<double>::Unit(n, j)));
+    return a.sparseView();
+  }
+  jacobian_type approximate_jacobian(const vec<double>& w, double mu) const {
+    Eigen::MatrixXd a = Eigen::MatrixXd(jacobian(w, mu)) - 0.5 * Eigen::MatrixXd::Identity(n, n);
+    return a.sparseView();
+  }
+
+ private:
+  double nu_;
+  Eigen::MatrixXd t_, ti_;
+};
+
+double spectrum_distance(const circle_family_system& sys, const vec<double>& w, double mu, double omega) {
+  Eigen::EigenSolver<Eigen::MatrixXd> es(Eigen::MatrixXd(sys.jacobian(w, mu)), false);
+  double best = 1e300;
+  for (const auto& l : es.eigenvalues()) best = std::min(best, std::abs(l - std::complex<double>(0, omega)));
+  return best;
+}
+
+/// Start near (mu, nu0) on the circle: perturbed equilibrium, inverse-power eigenvector.
+hopf_point circle_start(double nu0, double mu_guess, double omega_guess) {
+  const circle_family_system sys(nu0);
+  vec<double> w = sys.equilibrium();
+  hopf_point h = hopf_start(sys, w, mu_guess, omega_guess);
+  h.w.array() += 1e-4;  // the nested steady Newton has to polish it
+  return h;
+}
+
+hopf_curve_options circle_options() {
+  hopf_curve_options o;
+  o.step = 0.05;
+  o.max_step = 0.2;
+  o.nu_targets = {0.8};
+  o.mu_min = -0.9;
+  o.verbose = true;
+  return o;
+}
+
+double seconds_since(std::chrono::steady_clock::time_point t) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
+}
+
+}  // namespace
+
+TEST(hopf_curve_symmetric, circle_through_the_turning_point_in_nu) {
+  auto family = [](double nu) { return circle_family_system(nu); };
+  const double nu0 = 0.6;
+  const auto t0 = std::chrono::steady_clock::now();
+  const symmetric_hopf_curve_result r =
+      trace_symmetric_hopf_curve<2>(family, nu0, circle_start(nu0, 0.78, 1.2), circle_options(), +1);
+  std::cout << "symmetric circle: " << r.points.size() << " points, " << r.failed_correctors << " failed correctors, "
+            << r.linear_iterations << " GMRES iterations, " << r.steady_solves << " steady solves, "
+            << seconds_since(t0) << " s; " << r.stop_reason << "\n";
+  EXPECT_EQ(r.stop, hopf_curve_stop::mu_bounds);
+  ASSERT_GE(r.points.size(), 10u);
+  ASSERT_EQ(r.stats.size(), r.points.size());
+  double nu_hi = -9, worst_circle = 0, worst_omega = 0, worst_w = 0, worst_ev = 0;
+  std::vector<const hopf_curve_point*> landed;
+  for (const auto& pt : r.points) {
+    nu_hi = std::max(nu_hi, pt.nu);
+    const circle_family_system sys(pt.nu);
+    worst_circle = std::max(worst_circle, std::abs(pt.mu * pt.mu + pt.nu * pt.nu - 1));
+    worst_omega = std::max(worst_omega, std::abs(pt.omega - (1 + 0.3 * pt.mu)));
+    worst_w = std::max(worst_w, (pt.w - sys.equilibrium()).lpNorm<Eigen::Infinity>());
+    worst_ev = std::max(worst_ev, spectrum_distance(sys, pt.w, pt.mu, pt.omega));
+    if (pt.landed) landed.push_back(&pt);
+  }
+  std::cout << "symmetric circle: max |mu^2+nu^2-1| " << worst_circle << ", max |omega error| " << worst_omega
+            << ", max |w - w*| " << worst_w << ", max dist(i omega, spectrum) " << worst_ev << "\n";
+  EXPECT_LT(worst_circle, 1e-9);
+  EXPECT_LT(worst_omega, 1e-9);
+  EXPECT_LT(worst_w, 1e-10);
+  EXPECT_LT(worst_ev, 1e-8);
+  EXPECT_GT(nu_hi, 0.99);  // through the turning point nu = 1 (mu = 0)
+  // nu = 0.8 crossed before the turn (mu = 0.6) and after it (mu = -0.6); then the bound mu = -0.9
+  ASSERT_EQ(landed.size(), 3u);
+  EXPECT_NEAR(landed[0]->nu, 0.8, 1e-13);
+  EXPECT_NEAR(landed[0]->mu, 0.6, 1e-9);
+  EXPECT_NEAR(landed[1]->nu, 0.8, 1e-13);
+  EXPECT_NEAR(landed[1]->mu, -0.6, 1e-9);
+  EXPECT_NEAR(landed[2]->mu, -0.9, 1e-13);
+  EXPECT_NEAR(landed[2]->nu, std::sqrt(1 - 0.81), 1e-9);
+  EXPECT_TRUE(r.missed_targets.empty());
+
+  // The same curve by the full-system tracer (w unknown, sparse LU): the same landed points.
+  const hopf_curve_result full = trace_hopf_curve(family, nu0, circle_start(nu0, 0.78, 1.2), circle_options(), +1);
+  std::vector<const hopf_curve_point*> full_landed;
+  for (const auto& pt : full.points)
+    if (pt.landed) full_landed.push_back(&pt);
+  ASSERT_EQ(full_landed.size(), landed.size());
+  for (std::size_t k = 0; k < landed.size(); ++k) {
+    EXPECT_NEAR(landed[k]->nu, full_landed[k]->nu, 1e-10) << "landed point " << k;
+    EXPECT_NEAR(landed[k]->mu, full_landed[k]->mu, 1e-10) << "landed point " << k;
+    EXPECT_NEAR(landed[k]->omega, full_landed[k]->omega, 1e-10) << "landed point " << k;
+    EXPECT_LT((landed[k]->w - full_landed[k]->w).lpNorm<Eigen::Infinity>(), 1e-10) << "landed point " << k;
+  }
+}
+
+TEST(hopf_curve_symmetric, decreasing_direction_lands_on_the_lower_bound) {
+  auto family = [](double nu) { return circle_family_system(nu); };
+  hopf_curve_options o = circle_options();
+  o.nu_min = 0.3;
+  o.nu_targets = {};
+  o.mu_min = -std::numeric_limits<double>::infinity();
+  o.verbose = false;
+  const auto r = trace_symmetric_hopf_curve<2>(family, 0.6, circle_start(0.6, 0.78, 1.2), o, -1);
+  EXPECT_EQ(r.stop, hopf_curve_stop::nu_bounds);
+  ASSERT_GE(r.points.size(), 3u);
+  EXPECT_NEAR(r.points.back().nu, 0.3, 1e-13);
+  EXPECT_NEAR(r.points.back().mu, std::sqrt(1 - 0.09), 1e-9);
+  for (std::size_t k = 1; k < r.points.size(); ++k) EXPECT_LT(r.points[k].nu, r.points[k - 1].nu);
+}
+
+TEST(hopf_curve_symmetric, refuses_bad_input_and_reports_step_failure) {
+  auto family = [](double nu) { return circle_family_system(nu); };
+  const hopf_point start = circle_start(0.6, 0.78, 1.2);
+  hopf_curve_options o = circle_options();
+  o.verbose = false;
+  EXPECT_THROW(trace_symmetric_hopf_curve<2>(family, 0.6, start, o, 0), input_error);
+  EXPECT_THROW(trace_symmetric_hopf_curve<2>(family, NAN, start, o), input_error);
+  hopf_curve_options bad = o;
+  bad.step = 0;
+  EXPECT_THROW(trace_symmetric_hopf_curve<2>(family, 0.6, start, bad), input_error);
+  bad = o;
+  bad.nu_min = 0.7;
+  EXPECT_THROW(trace_symmetric_hopf_curve<2>(family, 0.6, start, bad), input_error);
+  hopf_point short_p = start;
+  short_p.p = short_p.p.head(3).eval();
+  EXPECT_THROW(trace_symmetric_hopf_curve<2>(family, 0.6, short_p, o), input_error);
+  hopf_point short_w = start;
+  short_w.w = short_w.w.head(5).eval();
+  EXPECT_THROW(trace_symmetric_hopf_curve<2>(family, 0.6, short_w, o), input_error);
+  symmetric_hopf_curve_options so;
+  so.fill_level = -1;
+  EXPECT_THROW(trace_symmetric_hopf_curve<2>(family, 0.6, start, o, 1, so), input_error);
+  so = {};
+  so.steady.abs_tolerance = 0;
+  EXPECT_THROW(trace_symmetric_hopf_curve<2>(family, 0.6, start, o, 1, so), input_error);
+
+  // A family that cannot be built beyond nu = 0.7 (a steady solve failing past some Mach number)
+  auto limited = [](double nu) {
+    require(nu <= 0.7, "test family: no system beyond nu = 0.7 (asked for ", nu, ")");
+    return circle_family_system(nu);
+  };
+  o.min_step = 1e-3;
+  try {
+    trace_symmetric_hopf_curve<2>(limited, 0.6, start, o);
+    ADD_FAILURE() << "no convergence_error";
+  } catch (const convergence_error& e) {
+    const std::string m = e.what();
+    EXPECT_NE(m.find("min_step"), std::string::npos) << m;
+    EXPECT_NE(m.find("no system beyond nu = 0.7"), std::string::npos) << m;
+  }
+  o.throw_on_failure = false;
+  const auto r = trace_symmetric_hopf_curve<2>(limited, 0.6, start, o);
+  EXPECT_EQ(r.stop, hopf_curve_stop::step_failure);
+  ASSERT_GE(r.points.size(), 2u);
+  EXPECT_LE(r.points.back().nu, 0.7);
+  EXPECT_GT(r.points.back().nu, 0.69);
+}
+
+// Heavy case (mu_s = 100) on the very coarse grid (stride 8, as the example), from M = 0.78 to
+// the landed point at M = 0.79.
+TEST(hopf_curve_symmetric, aerofoil_heavy_very_coarse_matches_fixed_mach_hopf_solve) {
+  using models::aerofoil_system;
+  auto make = [](double mach) {
+    structure::pitch_plunge_parameters p;
+    p.mu_s = 100;
+    return aerofoil_system(flow::euler_model<2>(flow::coarsen(flow::naca_cgrid(), 8), {.mach = mach, .alpha_rad = 0.0}),
+                           structure::pitch_plunge(p));
+  };
+  const double m0 = 0.78, m1 = 0.79;
+  const auto t0 = std::chrono::steady_clock::now();
+  const aerofoil_system s0 = make(m0);
+  const vec<double> w0 = s0.steady_equilibrium();
+  hopf_point guess = hopf_start(s0, w0, 4.6, 0.22);
+  guess.mu = 4.6;
+  hopf_curve_options o;
+  o.mu_scale = 0.5;
+  o.nu_scale = 0.05;
+  o.omega_scale = 0.05;
+  o.step = 0.5;
+  o.max_step = 1.0;
+  o.min_step = 1e-3;
+  o.nu_min = m0 - 1e-9;
+  o.nu_targets = {m1};
+  o.max_points = 3;
+  o.fast_iterations = 4;
+  o.verbose = true;
+  o.label = "heavy very coarse";
+  const auto r = trace_symmetric_hopf_curve<4>(make, m0, guess, o);
+  std::cout << "aerofoil: " << r.points.size() << " points in " << seconds_since(t0) << " s, stop: " << r.stop_reason
+            << "\n";
+  const hopf_curve_point* at = nullptr;
+  for (const auto& pt : r.points)
+    if (pt.landed) at = &pt;
+  ASSERT_NE(at, nullptr) << "M = 0.79 not reached";
+  EXPECT_NEAR(at->nu, m1, 1e-13);
+  // the start against the full-system tracer's start (out/aerofoil_flutter/hopf_curve_heavy_very_coarse.csv)
+  EXPECT_NEAR(std::abs(r.points[0].mu), 3.5484449637967996, 1e-7);
+  EXPECT_NEAR(r.points[0].omega, 0.23423217154293471, 1e-7);
+  // M = 0.79: independent steady solve (pseudo-transient, tight) and the fixed-Mach Hopf solver
+  const aerofoil_system s1 = make(m1);
+  flow::steady_options so;
+  so.residual_drop = 1e-13;
+  so.max_steps = 500;
+  const vec<double> w1 = s1.steady_equilibrium(so);
+  EXPECT_LT((at->w - w1).lpNorm<Eigen::Infinity>(), 1e-8);
+  hopf_options ho;
+  ho.symmetric = true;
+  hopf_point g = at->point();
+  g.w = w1;
+  g.mu *= 1.01;
+  g.omega *= 0.99;
+  const hopf_result h = solve_hopf_krylov<4>(s1, g, ho);
+  std::cout << std::setprecision(12) << "M = 0.79: traced Ubar " << at->mu << ", omega " << at->omega
+            << "; fixed-Mach solve " << h.point.mu << ", " << h.point.omega << "\n";
+  EXPECT_NEAR(at->mu, h.point.mu, 1e-8);
+  EXPECT_NEAR(at->omega, h.point.omega, 1e-8);
+  // and the full-system tracer's landed point at M = 0.79
+  EXPECT_NEAR(std::abs(at->mu), 3.5379158790270173, 1e-7);
+  EXPECT_NEAR(at->omega, 0.23343358002885775, 1e-7);
+}
