@@ -7,7 +7,8 @@
 //
 // Usage: aerofoil_branch [--grid very_coarse|coarse|medium] [--case heavy|light]
 //                        [--mach-min 0.78] [--mach-max 0.95] [--out out/aerofoil_flutter]
-//                        [--fill k] [--max-points N]
+//                        [--fill k] [--max-points N] [--max-step ds]
+//                        [--mu-scale s] [--nu-scale s] [--omega-scale s]   (metric, default 0.5 0.01 0.05)
 // Start: steady flow at mach-min from the free stream, inverse power at the case's (Ubar, omega)
 // guess, solve_hopf_krylov (as main.cpp). Every crossing of M = 0.01 k is landed exactly.
 // Output: <out>/hopf_curve_sym_<case>_<grid>.csv
@@ -40,6 +41,8 @@ struct options {
   double mach_min = 0.78, mach_max = 0.95;
   int fill = 1;
   int max_points = 400;
+  double mu_scale = 0.5, nu_scale = 0.01, omega_scale = 0.05;  // metric of the arclength
+  double max_step = 1.0;
 };
 
 /// Vertex of the parabola through three points (x_k, y_k): a turning point of y(x)... located
@@ -75,6 +78,10 @@ int main(int argc, char** argv) {
       else if (a == "--out") o.out = next();
       else if (a == "--fill") o.fill = std::stoi(next());
       else if (a == "--max-points") o.max_points = std::stoi(next());
+      else if (a == "--nu-scale") o.nu_scale = std::stod(next());
+      else if (a == "--mu-scale") o.mu_scale = std::stod(next());
+      else if (a == "--omega-scale") o.omega_scale = std::stod(next());
+      else if (a == "--max-step") o.max_step = std::stod(next());
       else throw input_error("unknown option " + a);
     }
     require(o.mach_min < o.mach_max, "--mach-min must be below --mach-max");
@@ -92,11 +99,11 @@ int main(int argc, char** argv) {
 
     auto family = [&](double mach) { return make_system(g, mach, c.mu_s); };
     hopf_curve_options ho;
-    ho.mu_scale = 0.5;
-    ho.nu_scale = 0.05;
-    ho.omega_scale = 0.05;
-    ho.step = 0.5;
-    ho.max_step = 1.0;
+    ho.mu_scale = o.mu_scale;
+    ho.nu_scale = o.nu_scale;
+    ho.omega_scale = o.omega_scale;
+    ho.max_step = o.max_step;
+    ho.step = std::min(0.5, o.max_step);
     ho.min_step = 1e-3;
     ho.nu_min = m0 - 1e-9;
     ho.nu_max = o.mach_max;
@@ -104,6 +111,7 @@ int main(int argc, char** argv) {
     ho.mu_max = 20.0;
     ho.max_points = o.max_points;
     ho.fast_iterations = 4;
+    ho.newton.max_iterations = 8;  // 3-5 quadratic steps when it converges; fail fast at kinks
     for (int k = static_cast<int>(std::ceil(m0 * 100 + 1e-6)); k <= static_cast<int>(std::floor(o.mach_max * 100 + 1e-6)); ++k)
       ho.nu_targets.push_back(k / 100.0);
     ho.throw_on_failure = false;
@@ -112,6 +120,8 @@ int main(int argc, char** argv) {
     ho.start.newton.max_iterations = 20;
     symmetric_hopf_curve_options so;
     so.fill_level = o.fill;
+    // third start of the nested steady Newton: the pseudo-transient solve from the free stream
+    so.equilibrium_start = [&](double mach) { return make_system(g, mach, c.mu_s).steady_equilibrium(); };
     csv_writer csv(o.out / ("hopf_curve_sym_" + c.name + "_" + g.name + ".csv"),
                    "mach,ubar,omega,newton_iterations,linear_iterations,step,seconds,landed");
     so.observer = [&](const hopf_curve_point& p, const symmetric_hopf_curve_stats& s) {
@@ -123,9 +133,9 @@ int main(int argc, char** argv) {
 
     // ---- summary ----
     const auto& pts = r.points;
-    std::printf("\n%zu points, stop: %s\n%d failed correctors, %ld GMRES iterations (Hopf system), %d nested steady "
+    std::printf("\n%zu points, stop: %s\n%d failed correctors, %d steps at fixed Mach or Ubar (kinks), %ld GMRES iterations (Hopf system), %d nested steady "
                 "solves (%.1f s), total %.1f s\n",
-                pts.size(), r.stop_reason.c_str(), r.failed_correctors, r.linear_iterations, r.steady_solves,
+                pts.size(), r.stop_reason.c_str(), r.failed_correctors, r.kink_steps, r.linear_iterations, r.steady_solves,
                 r.steady_seconds, r.seconds);
     if (!r.missed_targets.empty()) {
       std::printf("missed Mach targets:");

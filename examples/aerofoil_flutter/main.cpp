@@ -588,9 +588,12 @@ void reduced_part(const options& o, const std::map<std::string, boundary>& all) 
       v *= 0.01 / v[ia];
       const auto mh = march(s, ubar, (st.w + v.real()).eval(), (o.quick ? 2.0 : 3.0) * period,
                             "heavy_coarse_M0.80_0.97_smoothed", o);
-      int peaks = 0;
-      growth = peak_growth_rate(mh.t, mh.alpha, period, &peaks);
-      std::printf("  time marching at %.2f Ubar*: growth rate %+.6f (%d peaks, %.1f s)\n", f, growth, peaks, mh.seconds);
+      // mean envelope growth rate after the start transient (1.5 periods)
+      const auto env = amplitude_envelope(mh.t, mh.alpha, 1.5 * period);
+      growth = 0;
+      for (const auto& e : env) growth += e.growth_rate / double(env.size());
+      std::printf("  time marching at %.2f Ubar*: growth rate %+.6f (%zu envelope samples, %.1f s)\n", f, growth,
+                  env.size(), mh.seconds);
     }
     dc.row({ubar, lr.real(), lr.imag(), ep.lambda.real(), std::abs(ep.lambda.imag()), growth});
     std::printf("  Ubar = %.5f (%.2f Ubar*): reduced lambda = %+.6f %+.6fi, exact %+.6f %+.6fi\n", ubar, f, lr.real(),
@@ -600,8 +603,8 @@ void reduced_part(const options& o, const std::map<std::string, boundary>& all) 
   // LCO amplitude (pitch) of the reduced model
   csv_writer lc(o.out / "reduced_lco.csv", "ubar,alpha_amplitude,z_amplitude,frequency,stable");
   const double side = cm.l1 < 0 ? 1.0 : -1.0;  // supercritical: cycles above Ubar*
-  for (int k = 1; k <= 10; ++k) {
-    const double dmu = side * 0.005 * k * hp.mu;
+  for (double fr : {0.0005, 0.001, 0.002, 0.005, 0.01, 0.015, 0.02, 0.03, 0.04, 0.05}) {
+    const double dmu = side * fr * hp.mu;
     const auto l = model.lco(dmu);
     if (!l.exists) continue;
     const auto [amp, mean] = model.component_amplitude(ia, dmu);
@@ -612,54 +615,70 @@ void reduced_part(const options& o, const std::map<std::string, boundary>& all) 
   }
   if (!o.verify) return;
 
-  // Verification of the cubic term by time marching: the amplitude-dependent growth rate. On the
-  // centre manifold |z|' = |z| (Re(a) dmu + Re(c1) |z|^2), and the pitch amplitude is kappa |z|
-  // (kappa = 2 |p_alpha|; the k20, k11 terms carry no pitch at a symmetric equilibrium), so the
-  // reduced model predicts sigma(A) = Re(a) dmu + Re(c1) (A / kappa)^2, zero at the LCO.
-  // Full-system BDF2 runs started ON the manifold (w = reconstruct(z0)) at pitch amplitudes
-  // below and above the predicted cycle give measured (A, sigma) pairs along their envelopes;
-  // a least-squares line sigma = s0 + s2 A^2 through them gives the time-marching LCO
-  // amplitude sqrt(-s0 / s2). Marching to the cycle itself would take hundreds of periods here.
-  csv_writer ec(o.out / "reduced_envelope.csv", "ubar,run,t,alpha_amplitude,growth_march,growth_model");
+  // Verification of the nonlinear term by time marching: the amplitude-dependent growth rate.
+  // On the centre manifold |z|' = |z| (Re(a) dmu + Re(c1) |z|^2), and the pitch amplitude is
+  // kappa |z| (kappa = 2 |p_alpha|; k20 and k11 carry no pitch at a symmetric equilibrium), so
+  // the model predicts sigma(A) = Re(a) dmu + Re(c1) (A / kappa)^2, zero on the LCO. BDF2 runs
+  // of the full system started ON the manifold (w = reconstruct(z0)) give measured (A, sigma)
+  // along their envelopes (amplitude_envelope; the first 1.5 periods are skipped as transient).
+  // (a) at Ubar* (dmu = 0) the measured sigma(A) checks Re(c1) directly, amplitude by amplitude;
+  // (b) above it, runs from below and above the predicted cycle and a least-squares line
+  //     sigma = s0 + s2 A^2 through their samples give the time-marching LCO amplitude
+  //     sqrt(-s0 / s2) (marching onto the cycle itself would take hundreds of periods here).
+  csv_writer ec(o.out / "reduced_envelope.csv", "ubar,start_amplitude,t,alpha_amplitude,growth_march,growth_model");
+  csv_writer lm(o.out / "reduced_lco_march.csv",
+                "ubar,alpha_amplitude_model,alpha_amplitude_march,growth0_model,growth0_march,runs");
   const double kappa = 2.0 * std::abs(cm.p[ia]);
   const double re_a = model.z_mu_coefficient().real();
-  for (double f : o.quick ? std::vector<double>{1.03} : std::vector<double>{1.02, 1.04}) {
-    const double dmu = side * (f - 1.0) * hp.mu, ubar = hp.mu + dmu;
+  auto model_rate = [&](double dmu, double amp) { return re_a * dmu + cm.c1.real() * std::pow(amp / kappa, 2); };
+  struct fit {
+    double sx = 0, sy = 0, sxx = 0, sxy = 0;
+    int n = 0;
+  };
+  // one run: envelope samples to the CSV and the fit; returns the mean measured and model rates
+  auto envelope_run = [&](double dmu, double a0, const std::string& tag, fit& f) {
+    const double ubar = hp.mu + dmu;
+    const auto mh = march(s, ubar, model.reconstruct(cplx(a0 / kappa, 0.0), dmu), (o.quick ? 4.0 : 5.0) * period, tag, o);
+    const auto env = amplitude_envelope(mh.t, mh.alpha, 1.5 * period);
+    double gm = 0, gp = 0, am = 0;
+    for (const auto& e : env) {
+      const double g = model_rate(dmu, e.amplitude);
+      ec.row({ubar, a0, e.t, e.amplitude, e.growth_rate, g});
+      const double x = e.amplitude * e.amplitude;
+      f.sx += x;
+      f.sy += e.growth_rate;
+      f.sxx += x * x;
+      f.sxy += x * e.growth_rate;
+      ++f.n;
+      gm += e.growth_rate / double(env.size());
+      gp += g / double(env.size());
+      am += e.amplitude / double(env.size());
+    }
+    std::printf("    Ubar = %.5f, start %.5f rad: mean amplitude %.5f, growth rate %+.4e (time marching) vs %+.4e "
+                "(reduced model), %zu envelope samples, %.1f s\n",
+                ubar, a0, am, gm, gp, env.size(), mh.seconds);
+  };
+  std::cout << "  (a) amplitude-dependent growth rate at Ubar* (pure cubic term):\n";
+  for (double a0 : o.quick ? std::vector<double>{0.002} : std::vector<double>{0.001, 0.002, 0.004}) {
+    fit f;
+    envelope_run(0.0, a0, "heavy_coarse_M0.80_envelope_" + fixed(a0, 3), f);
+  }
+  std::cout << "  (b) LCO amplitude above Ubar*: reduced model vs time marching (envelope fit)\n";
+  for (double fct : o.quick ? std::vector<double>{1.002} : std::vector<double>{1.001, 1.002, 1.02}) {
+    const double dmu = side * (fct - 1.0) * hp.mu, ubar = hp.mu + dmu;
     const auto l = model.lco(dmu);
     if (!l.exists) continue;
     const double a_pred = kappa * l.amplitude;
-    std::printf("  envelope runs at Ubar = %.5f: predicted LCO pitch amplitude %.5f rad\n", ubar, a_pred);
-    double sx = 0, sy = 0, sxx = 0, sxy = 0;
-    int n = 0;
-    for (double start : {0.6, 1.4}) {
-      const cplx z0(start * l.amplitude, 0.0);
-      const std::string tag = "heavy_coarse_M0.80_lco_" + fixed(ubar / hp.mu, 2) + "_" + fixed(start, 1);
-      const auto mh = march(s, ubar, model.reconstruct(z0, dmu), (o.quick ? 3.0 : 5.0) * period, tag, o);
-      const auto env = amplitude_envelope(mh.t, mh.alpha, 0.5 * period);
-      for (const auto& e : env) {
-        const double r = e.amplitude / kappa;
-        const double model_rate = re_a * dmu + cm.c1.real() * r * r;
-        ec.row({ubar, start, e.t, e.amplitude, e.growth_rate, model_rate});
-        sx += e.amplitude * e.amplitude;
-        sy += e.growth_rate;
-        sxx += std::pow(e.amplitude, 4);
-        sxy += e.amplitude * e.amplitude * e.growth_rate;
-        ++n;
-      }
-      if (!env.empty())
-        std::printf("    start %.1f x predicted: amplitude %.5f -> %.5f rad, growth %+.6f -> %+.6f (model %+.6f -> %+.6f), "
-                    "%.1f s\n",
-                    start, env.front().amplitude, env.back().amplitude, env.front().growth_rate, env.back().growth_rate,
-                    re_a * dmu + cm.c1.real() * std::pow(env.front().amplitude / kappa, 2),
-                    re_a * dmu + cm.c1.real() * std::pow(env.back().amplitude / kappa, 2), mh.seconds);
-    }
-    if (n >= 3) {
-      const double s2 = (n * sxy - sx * sy) / (n * sxx - sx * sx), s0 = (sy - s2 * sx) / n;
-      const double a_march = -s0 / s2 > 0 ? std::sqrt(-s0 / s2) : NAN;
-      std::printf("  Ubar = %.5f: LCO pitch amplitude, time marching (envelope fit) %.5f rad vs reduced model %.5f "
-                  "(%+.1f %%); growth at zero amplitude %+.6f vs %+.6f\n",
-                  ubar, a_march, a_pred, 100 * (a_march / a_pred - 1), s0, re_a * dmu);
-    }
+    fit f;
+    for (double start : {0.6, 1.4})
+      envelope_run(dmu, start * a_pred, "heavy_coarse_M0.80_lco_" + fixed(fct, 3) + "_" + fixed(start, 1), f);
+    if (f.n < 3) continue;
+    const double s2 = (f.n * f.sxy - f.sx * f.sy) / (f.n * f.sxx - f.sx * f.sx), s0 = (f.sy - s2 * f.sx) / f.n;
+    const double a_march = -s0 / s2 > 0 ? std::sqrt(-s0 / s2) : NAN;
+    lm.row({ubar, a_pred, a_march, re_a * dmu, s0, 2LL});
+    std::printf("  Ubar = %.5f (%.3f Ubar*): LCO pitch amplitude %.5f rad (time marching) vs %.5f (reduced model), %+.1f %%; "
+                "growth at zero amplitude %+.4e vs %+.4e\n",
+                ubar, ubar / hp.mu, a_march, a_pred, 100 * (a_march / a_pred - 1), s0, re_a * dmu);
   }
 }
 

@@ -7,7 +7,8 @@ boundaries.png  Ubar*(M) for both cases and grids, with the time-marching points
                 (filled: decaying at 0.97 Ubar*, crosses: growing at 1.03 Ubar*)
 spectra.png     very coarse light case M = 0.5: eigenvalues at Ubar* - 0.01, Ubar*, Ubar* + 0.01
 histories.png   pitch histories of the time-marching runs
-reduced.png     reduced model (heavy case): damping vs the exact eigenvalue, LCO amplitude
+reduced.png     reduced model (heavy case): damping vs the exact eigenvalue, growth rate vs
+                amplitude at Ubar*, LCO amplitude vs Ubar, against time marching
 """
 import csv
 import glob
@@ -100,7 +101,9 @@ def spectra(out):
 
 
 def histories(out):
-    files = sorted(glob.glob(os.path.join(out, "history_*.csv")))
+    # the verification runs (history_<case>_<grid>_M<mach>_<factor>.csv), not the reduced model's
+    files = [f for f in sorted(glob.glob(os.path.join(out, "history_*.csv")))
+             if "_lco_" not in f and "_envelope_" not in f and "smoothed" not in f]
     if not files:
         return
     fig, ax = plt.subplots(figsize=(9, 5))
@@ -113,26 +116,43 @@ def histories(out):
 
 
 def reduced(out):
-    dpath, lpath = os.path.join(out, "reduced_damping.csv"), os.path.join(out, "reduced_lco.csv")
+    dpath = os.path.join(out, "reduced_damping.csv")
+    lpath, mpath = os.path.join(out, "reduced_lco.csv"), os.path.join(out, "reduced_lco_march.csv")
+    epath = os.path.join(out, "reduced_envelope.csv")
     if not os.path.exists(dpath):
         return
     d = read(dpath)
-    n = 2 if os.path.exists(lpath) else 1
-    fig, axes = plt.subplots(1, n, figsize=(5.5 * n, 4.5), squeeze=False)
-    ax = axes[0][0]
+    fig, axes = plt.subplots(1, 3, figsize=(16, 4.5))
+    ax = axes[0]
     ax.plot(col(d, "ubar"), col(d, "re_reduced"), "-", label="reduced model")
     ax.plot(col(d, "ubar"), col(d, "re_exact"), "o", mfc="none", label="exact eigenvalue (inverse power)")
-    if "growth_march" in d[0]:
-        g = [(float(r["ubar"]), float(r["growth_march"])) for r in d if r["growth_march"] not in ("", "nan")]
-        if g:
-            ax.plot(*zip(*g), "x", ms=8, label="time marching")
+    g = [(float(r["ubar"]), float(r["growth_march"])) for r in d if r["growth_march"] not in ("", "nan")]
+    if g:
+        ax.plot(*zip(*g), "x", ms=8, label="time marching")
     ax.axhline(0, color="gray", lw=0.8)
     finish_axes(ax, "$\\bar U$", "Re $\\lambda$ (growth rate)", "damping of the critical mode")
-    if n == 2:
+    # growth rate against amplitude at Ubar* (the lowest Ubar of the envelope runs)
+    ax = axes[1]
+    if os.path.exists(epath):
+        e = read(epath)
+        if e:
+            u0 = min(float(r["ubar"]) for r in e)
+            sel = sorted((r for r in e if abs(float(r["ubar"]) - u0) < 1e-12), key=lambda r: float(r["alpha_amplitude"]))
+            ax.plot(col(sel, "alpha_amplitude"), col(sel, "growth_march"), "x", label="time marching (envelopes)")
+            k = float(sel[-1]["growth_model"]) / float(sel[-1]["alpha_amplitude"]) ** 2  # Re(c1) / kappa^2
+            amax = 1.1 * float(sel[-1]["alpha_amplitude"])
+            a = [amax * i / 100 for i in range(101)]
+            ax.plot(a, [k * x * x for x in a], "-", label="reduced model Re(c1) (A/kappa)$^2$")
+    finish_axes(ax, "pitch amplitude A (rad)", "growth rate of A", "amplitude-dependent damping at $\\bar U^*$")
+    ax = axes[2]
+    if os.path.exists(lpath):
         lrows = read(lpath)
-        ax = axes[0][1]
-        ax.plot(col(lrows, "ubar"), col(lrows, "alpha_amplitude"), "-", label="Taylor coefficients (not verified)")
-        finish_axes(ax, "$\\bar U$", "LCO pitch amplitude (rad)", "reduced-model LCO amplitude")
+        ax.plot(col(lrows, "ubar"), col(lrows, "alpha_amplitude"), "-", label="reduced model")
+    if os.path.exists(mpath):
+        m = [r for r in read(mpath) if r["alpha_amplitude_march"] not in ("", "nan")]
+        if m:
+            ax.plot(col(m, "ubar"), col(m, "alpha_amplitude_march"), "o", mfc="none", label="time marching (envelope fit)")
+    finish_axes(ax, "$\\bar U$", "LCO pitch amplitude (rad)", "supercritical LCO")
     save(fig, out, "reduced.png")
 
 
