@@ -23,6 +23,7 @@
 #include <complex>
 #include <iomanip>
 #include <iostream>
+#include <limits>
 
 using namespace aerohopf;
 
@@ -38,7 +39,10 @@ class circle_family_system {
   using jacobian_type = Eigen::SparseMatrix<double>;
   static constexpr int n = 8;
 
-  explicit circle_family_system(double nu) : nu_(nu) {
+  /// kink > 0: a = 1 - mu^2 - nu^2 + kink max(0, nu - 0.7), continuous but not differentiable
+  /// in nu at 0.7 (a C1 discretisation's switch crossed by the equilibrium); the curve
+  /// mu^2 = 1 - nu^2 + kink max(0, nu - 0.7) turns there by more than 90 degrees for kink = 5.
+  explicit circle_family_system(double nu, double kink = 0.0) : nu_(nu), kink_(kink) {
     t_.setZero(n, n);
     for (int i = 0; i < n; ++i)
       for (int j = 0; j < n; ++j)
@@ -61,7 +65,7 @@ class circle_family_system {
       z[i] = T(0.0);
       for (int j = 0; j < n; ++j) z[i] += T(ti_(i, j)) * (w[j] - T(we[j]));
     }
-    const T a = T(1.0) - mu * mu - T(nu_ * nu_), b = T(1.0) + T(0.3) * mu;
+    const T a = T(1.0) - mu * mu - T(nu_ * nu_ - kink_ * std::max(0.0, nu_ - 0.7)), b = T(1.0) + T(0.3) * mu;
     vec<T> g(n);
     g[0] = a * z[0] - b * z[1] + T(0.5) * z[0] * z[0] - z[1] * z[2];
     g[1] = b * z[0] + a * z[1] + z[0] * z[1] + T(0.3) * z[2] * z[2];
@@ -84,7 +88,7 @@ class circle_family_system {
   }
 
  private:
-  double nu_;
+  double nu_, kink_ = 0;
   Eigen::MatrixXd t_, ti_;
 };
 
@@ -187,6 +191,40 @@ TEST(hopf_curve_symmetric, decreasing_direction_lands_on_the_lower_bound) {
   EXPECT_NEAR(r.points.back().nu, 0.3, 1e-13);
   EXPECT_NEAR(r.points.back().mu, std::sqrt(1 - 0.09), 1e-9);
   for (std::size_t k = 1; k < r.points.size(); ++k) EXPECT_LT(r.points[k].nu, r.points[k - 1].nu);
+}
+
+// A kink of the curve at nu = 0.7 where it turns by ~117 degrees in the metric: the arclength
+// corrector cannot cross it at any step size; the fixed-nu fallback does.
+TEST(hopf_curve_symmetric, crosses_a_kink_at_fixed_nu) {
+  auto family = [](double nu) { return circle_family_system(nu, 5.0); };
+  hopf_curve_options o = circle_options();
+  o.nu_targets = {0.75};
+  o.mu_min = -std::numeric_limits<double>::infinity();
+  o.nu_max = 0.8;
+  o.min_step = 1e-4;
+  o.verbose = false;
+  const auto r = trace_symmetric_hopf_curve<2>(family, 0.6, circle_start(0.6, 0.78, 1.2), o);
+  std::cout << "kink: " << r.points.size() << " points, " << r.kink_steps << " fixed-parameter steps, "
+            << r.failed_correctors << " failed correctors; " << r.stop_reason << "\n";
+  EXPECT_EQ(r.stop, hopf_curve_stop::nu_bounds);
+  EXPECT_GE(r.kink_steps, 1);
+  double worst = 0;
+  for (const auto& pt : r.points)
+    worst = std::max(worst, std::abs(pt.mu * pt.mu - (1 - pt.nu * pt.nu + 5.0 * std::max(0.0, pt.nu - 0.7))));
+  EXPECT_LT(worst, 1e-9);
+  const hopf_curve_point* at = nullptr;
+  for (const auto& pt : r.points)
+    if (pt.landed && std::abs(pt.nu - 0.75) < 1e-12) at = &pt;
+  ASSERT_NE(at, nullptr);
+  EXPECT_NEAR(at->mu, std::sqrt(1 - 0.5625 + 0.25), 1e-9);
+  EXPECT_NEAR(at->omega, 1 + 0.3 * at->mu, 1e-9);
+  // without the fallback the trace stops at the kink
+  symmetric_hopf_curve_options so;
+  so.kink_fallback = false;
+  o.throw_on_failure = false;
+  const auto stuck = trace_symmetric_hopf_curve<2>(family, 0.6, circle_start(0.6, 0.78, 1.2), o, 1, so);
+  EXPECT_EQ(stuck.stop, hopf_curve_stop::step_failure);
+  EXPECT_LT(stuck.points.back().nu, 0.7 + 1e-3);
 }
 
 TEST(hopf_curve_symmetric, refuses_bad_input_and_reports_step_failure) {

@@ -61,6 +61,26 @@
 // linear extrapolation), one dw0/dnu solve, assembly of A, L, A_mu, one complex BILU(k), four
 // taylor products for G_nu, one GMRES on J.
 //
+// Kinks. A discretisation that is only C1 (the Osher flux's subpath switches at sonic points,
+// limiters) has a Jacobian A that is continuous but not differentiable in w, so the Hopf curve
+// is continuous with KINKS wherever a face of the steady flow crosses a switch as nu changes
+// (measured: heavy case, coarse grid, M = 0.7888: dUbar/dM jumps from +29 to -11 within
+// dM = 2e-5, and again 2e-4 later; the fixed-Mach Hopf solves converge on both sides). Where
+// the curve turns by more than 90 degrees in the metric at a kink, the arclength hyperplane
+// does not meet the next piece near the prediction and no step size helps. As w0 depends on
+// nu only, the switches are crossed at fixed values of nu: the kinks lie on lines nu = const.
+// kink_fallback: after the arclength corrector failed (secant and exact tangent), the same
+// step is retried with the last row fixing nu (or first mu where the curve is nearly vertical
+// in nu), then the other one, at its value predicted along the secant -- a local
+// parametrisation, which crosses the kink as natural continuation does (measured: at a peak
+// of Ubar(M) at a kink, M = 0.8850 coarse grid, only fixed M crosses) -- and accepted if it
+// lands within kink_distance x step of the last point and ahead along the secant. A corrected point that goes back along the secant
+// (possible after the exact-tangent retry at a kink: measured, the trace reversed at M = 0.867
+// and retraced the curve) is rejected like a sheet jump.
+// Nested steady solves that fail from the extrapolated start are retried from the nearest
+// solved equilibrium and then from equilibrium_start(nu) if given (transonic flow: the shock
+// moves fast with M, and Newton from the extrapolation can meet non-physical states).
+//
 // Everything else mirrors hopf_curve.hpp and uses its option and result types: metric and
 // step control (halve on failure, grow after <= fast_iterations, clamp), retry along the exact
 // tangent after a failed secant step, the sheet-jump guard (corrector_distance, min_cosine),
@@ -107,6 +127,7 @@ struct symmetric_hopf_curve_stats {
 
 struct symmetric_hopf_curve_result : hopf_curve_result {
   std::vector<symmetric_hopf_curve_stats> stats;  ///< one per point, including failed attempts
+  int kink_steps = 0;                   ///< steps taken at fixed mu or nu (kink_fallback)
   long linear_iterations = 0;
   int steady_solves = 0;
   double steady_seconds = 0;
@@ -131,9 +152,19 @@ struct symmetric_hopf_curve_options {
     newton_options o;
     o.abs_tolerance = 1e-11;  ///< on ||f(w, mu; nu)||_2
     o.max_iterations = 12;
+    o.line_search = true;     ///< halve while ||f|| does not decrease (or is not finite)
     return o;
   }();                              ///< nested steady Newton (throw_on_failure is ignored)
   std::size_t equilibrium_cache = 8;  ///< solved equilibria kept (by nu)
+  /// After the arclength corrector failed along the secant and the exact tangent, retry the
+  /// same step at fixed mu or nu (file comment: kinks of the curve of a C1 discretisation);
+  /// accepted if it lands ahead along the secant within kink_distance x step of the last point.
+  bool kink_fallback = true;
+  /// A start for the nested steady Newton at nu, tried when the warm starts (extrapolation along
+  /// dw0/dnu, then the nearest solved equilibrium) fail, e.g. a pseudo-transient steady solve
+  /// from the free stream (aerofoil_system::steady_equilibrium). Empty: no third start.
+  std::function<vec<double>(double)> equilibrium_start;
+  double kink_distance = 2.0;
   /// Called for every accepted point with its costs (after hopf_curve_options::observer).
   std::function<void(const hopf_curve_point&, const symmetric_hopf_curve_stats&)> observer;
 };
@@ -315,7 +346,25 @@ symmetric_hopf_curve_result trace_symmetric_hopf_curve(const F& family, double n
       const S& sb = system_at(aux, best->nu);
       ensure_derivative(*best, mu, blocked(sb.jacobian(best->w, mu)), blocked(lhs_jacobian(sb, best->w, mu)));
     }
-    vec<double> w = steady_solve(nu, mu, vec<double>(best->w + (nu - best->nu) * best->dw));
+    // warm starts in turn: linear extrapolation, the nearest equilibrium, the user's start
+    vec<double> w;
+    std::string failures;
+    for (int attempt = 0; attempt < 3 && w.size() == 0; ++attempt) {
+      if (attempt == 2 && !sopt.equilibrium_start) break;
+      try {
+        vec<double> w0 = attempt == 0   ? vec<double>(best->w + (nu - best->nu) * best->dw)
+                         : attempt == 1 ? best->w
+                                        : sopt.equilibrium_start(nu);
+        require(w0.size() == n, lab, ": equilibrium_start(", nu, ") has ", w0.size(), " entries, system ", n);
+        w = steady_solve(nu, mu, std::move(w0));
+      } catch (const error& e) {
+        failures += internal::concat(failures.empty() ? "" : "; ",
+                                     attempt == 0 ? "from the extrapolated" : attempt == 1 ? "from the nearest" : "from the user's",
+                                     " start: ", e.what());
+      }
+    }
+    if (w.size() == 0)
+      throw convergence_error(internal::concat(lab, ": no steady state at nu = ", nu, " (", failures, ")"));
     if (cache.size() >= std::max<std::size_t>(sopt.equilibrium_cache, 2)) cache.erase(cache.begin());
     cache.push_back({nu, std::move(w), vec<double>()});
     return cache.back();
@@ -540,6 +589,7 @@ symmetric_hopf_curve_result trace_symmetric_hopf_curve(const F& family, double n
     const auto t_point = clock::now();
     int attempts = 0;
     bool exact_t = false;
+    const vec<double> t_secant = t;  // the direction of travel so far (t may become the exact tangent)
     std::optional<corrected> xn;
     for (;;) {
       ++attempts;
@@ -559,6 +609,10 @@ symmetric_hopf_curve_result trace_symmetric_hopf_curve(const F& family, double n
           xn.reset();
         } else if (!(ydot(d, t) > opt.min_cosine * dn)) {
           last_failure = "the corrected point lies behind the last point or off the predicted direction";
+          xn.reset();
+        } else if (!(ydot(d, t_secant) > 0)) {
+          // after the exact-tangent retry at a kink: a step back along the traced curve
+          last_failure = "the corrected point goes back along the traced curve";
           xn.reset();
         }
       }
@@ -582,6 +636,39 @@ symmetric_hopf_curve_result trace_symmetric_hopf_curve(const F& family, double n
         *opt.log << lab << ": step " << ds << " from nu = " << x[inu] << ", mu = " << x[imu] << " failed ("
                  << last_failure << "), " << (retry_same ? "retrying along the exact tangent" : "halving") << std::endl;
       if (retry_same) continue;
+      if (sopt.kink_fallback) {
+        // Local parametrisation (file comment): the same step at fixed nu or mu at its value
+        // predicted along the secant; nu first (the kinks lie on lines nu = const) unless the
+        // curve is nearly vertical in nu there, then the other one (at a kink where one of
+        // them reverses, only the other crosses it).
+        const double rnu = std::abs(t_secant[inu]) / sig[1], rmu = std::abs(t_secant[imu]) / sig[0];
+        const int order[2] = {rnu >= 0.1 * rmu ? 1 : 0, rnu >= 0.1 * rmu ? 0 : 1};
+        const vec<double> xp = x + ds * t_secant;
+        for (int j : order) {
+          double c[3] = {0, 0, 0};
+          c[j] = 1;
+          auto xk = correct(xp, s, c, yv(xp, j));
+          if (xk) {
+            const double dist = ydist(xk->x, x);
+            const bool forward = ydot(vec<double>(xk->x - x), t_secant) > 0;
+            if (forward && dist <= sopt.kink_distance * ds) {
+              xn = std::move(xk);
+              ++res.kink_steps;
+              if (opt.verbose && opt.log)
+                *opt.log << lab << ": step " << ds << " from nu = " << x[inu] << ", mu = " << x[imu] << " taken at fixed "
+                         << (j ? "nu" : "mu") << " (a kink of the curve?)" << std::endl;
+              break;
+            }
+            last_failure = forward ? internal::concat("fixed-", j ? "nu" : "mu", " step landed ", dist,
+                                                      " from the last point (step ", ds, ")")
+                                   : internal::concat("fixed-", j ? "nu" : "mu", " step went back along the curve");
+          } else {
+            last_failure = internal::concat("fixed-", j ? "nu" : "mu", " step failed: ", last_failure);
+          }
+          if (opt.verbose && opt.log) *opt.log << lab << ": " << last_failure << std::endl;
+        }
+        if (xn) break;
+      }
       ds *= 0.5;
       if (ds < opt.min_step) {
         const std::string why = internal::concat(
