@@ -87,6 +87,9 @@ TEST(hopf_bordered, krylov_newton_matches_and_converges_quadratically) {
     EXPECT_LT(eigen_residual(f.s, r.point), 1e-9);
     EXPECT_GT(r.linear_iterations, 0);
     EXPECT_LE(r.report.iterations, 7);
+    EXPECT_GT(r.setup_seconds, 0.0);  // the timing split is filled in
+    EXPECT_GT(r.linear_seconds, 0.0);
+    EXPECT_GT(r.residual_seconds, 0.0);
     ASSERT_GE(h.size(), 3u);
     if (!reuse) {  // exact Newton with inexact (eta = O(|F|)) solves: at least superlinear
       for (std::size_t k = 1; k + 1 < h.size(); ++k)

@@ -64,6 +64,9 @@ struct hopf_result {
   vec<double> s;         ///< the normalisation vector used
   newton_report report;  ///< per-iteration residuals of the augmented system
   long linear_iterations = 0;  ///< Krylov iterations over all solves (0 for direct solvers)
+  /// Wall-clock split (solve_hopf_krylov only; 0 elsewhere): matrix assembly and preconditioner
+  /// factorisation, Krylov solves, and residual evaluations.
+  double setup_seconds = 0, linear_seconds = 0, residual_seconds = 0;
 };
 
 /// Rotates the phase of p and scales it so that s.p_r = 0 and s.p_i = 1 for the returned s

@@ -51,6 +51,7 @@
 #include <Eigen/Core>
 
 #include <algorithm>
+#include <chrono>
 #include <complex>
 #include <iomanip>
 #include <string>
@@ -248,7 +249,15 @@ hopf_result solve_hopf_krylov(const S& sys, const hopf_point& guess, const hopf_
   const Eigen::Index n = prob.n, N = prob.N;
   const vec<double>& w = prob.w;
   const vec<double>& s = prob.s;
-  auto residual = [&](const vec<double>& y) { return prob.residual(y); };
+  double setup_seconds = 0, linear_seconds = 0, residual_seconds = 0;
+  using clock = std::chrono::steady_clock;
+  auto since = [](clock::time_point t0) { return std::chrono::duration<double>(clock::now() - t0).count(); };
+  auto residual = [&](const vec<double>& y) {
+    const auto t0 = clock::now();
+    vec<double> f = prob.residual(y);
+    residual_seconds += since(t0);
+    return f;
+  };
 
   block_ilu_options io;
   io.fill_level = kopt.fill_level;
@@ -262,12 +271,14 @@ hopf_result solve_hopf_krylov(const S& sys, const hopf_point& guess, const hopf_
   // A, A_mu and the BILU of L - i omega I at (mu, omega); the exact Jacobian is assembled once
   // and also serves as L when precondition_exact.
   auto refresh = [&](double mu, double om) {
+    const auto t0 = clock::now();
     const M exact = sys.jacobian(w, mu);
     a = block_sparse_matrix<double, B>::from_sparse(exact, B);
     amu = jacobian_d_mu(sys, w, mu);
     mu0 = mu;
     const auto lb = kopt.precondition_exact ? a : block_sparse_matrix<double, B>::from_sparse(lhs_jacobian(sys, w, mu), B);
     ilu.compute(shifted(lb, C(0.0, om)));
+    setup_seconds += since(t0);
   };
   if (kopt.reuse_matrices) refresh(x[N - 2], x[N - 1]);
   auto step = [&](const vec<double>& y, const vec<double>& f, int it) {
@@ -323,14 +334,20 @@ hopf_result solve_hopf_krylov(const S& sys, const hopf_point& guess, const hopf_
     ko.throw_on_failure = true;
     vec<double> dx = vec<double>::Zero(N);
     const vec<double> rhs = -f;
+    const auto t0 = clock::now();
     const krylov_report rep = gmres<double>(jop, jpre, rhs, dx, ko);
+    linear_seconds += since(t0);
     linear_iterations += rep.iterations;
     return dx;
   };
   newton_options nopt = opt.newton;
   prob.add_progress(nopt, opt, linear_iterations);
   newton_result nr = newton_iterate(residual, step, x, nopt, opt.label + " (Hopf system, BILU-GMRES)");
-  return prob.result(std::move(nr), linear_iterations, opt);
+  hopf_result res = prob.result(std::move(nr), linear_iterations, opt);
+  res.setup_seconds = setup_seconds;
+  res.linear_seconds = linear_seconds;
+  res.residual_seconds = residual_seconds;
+  return res;
 }
 
 }  // namespace aerohopf
