@@ -174,6 +174,28 @@ hopf_options hopf_opts(const std::string& label, double tolerance = 1e-10) {
   return ho;
 }
 
+/// Inverse-power start of the Hopf Newton iteration at (w, Ubar) with shift i omega (spec 02):
+/// GMRES on the exact A - i omega I preconditioned by the complex BILU(k) of the modified-order
+/// L - i omega I (krylov_solver::precondition_with); no sparse LU. GMRES to 1e-9 per solve:
+/// inexact inverse iteration stagnates near the solve tolerance (inverse_power.hpp).
+hopf_point krylov_start(const aerofoil_system& s, const vec<double>& w, double ubar, double omega, int fill) {
+  krylov_solver_options ko;
+  ko.fill_level = fill;
+  ko.krylov.relative_tolerance = 1e-9;
+  ko.krylov.max_iterations = 2000;
+  ko.krylov.restart = 80;
+  ko.krylov.record_history = false;
+  krylov_solver<Eigen::SparseMatrix<cplx>, 4> solver(ko, "inverse power, complex BILU-GMRES");
+  solver.precondition_with(shifted(lhs_jacobian(s, w, ubar), cplx(0.0, omega)));
+  inverse_power_options ipo;
+  ipo.tolerance = 1e-8;  // a start for Newton, which converges the pair exactly
+  const auto t0 = clk::now();
+  const eigen_pair ep = inverse_power(s.jacobian(w, ubar), cplx(0.0, omega), ipo, nullptr, solver);
+  std::printf("    inverse power (BILU(%d)-GMRES): lambda = %+.6f %+.6fi, %d iterations, %ld GMRES iterations, %.2f s\n",
+              fill, ep.lambda.real(), ep.lambda.imag(), ep.iterations, ep.linear_iterations, seconds_since(t0));
+  return aerohopf::internal::hopf_point_from(w, ubar, ep);
+}
+
 // ---------------------------------------------------------------------------------------------
 // Part 1: very coarse grid, light case, M = 0.5: Hopf point and the dense spectra around it.
 
@@ -183,7 +205,7 @@ void spectra_part(const options& o) {
   const auto st = steady(s);
   hopf_options ho = hopf_opts("hopf very coarse");
   ho.verbose = true;
-  const hopf_result h = solve_hopf_krylov<4>(s, hopf_start(s, st.w, light_case.ubar_guess, light_case.omega_guess), ho);
+  const hopf_result h = solve_hopf_krylov<4>(s, krylov_start(s, st.w, light_case.ubar_guess, light_case.omega_guess, o.fill), ho);
   const double ubar = h.point.mu, omega = h.point.omega;
   std::cout << std::setprecision(10) << "very coarse grid (" << s.flow().n_cells() << " cells), light case, M = 0.5: Ubar* = "
             << ubar << ", omega* = " << omega << " (" << h.report.iterations << " Newton iterations)\n";
@@ -297,7 +319,7 @@ boundary natural_boundary(const structural_case& c, const grid_level& g, const s
         guess = it->point;
         guess.p = s.prolong_from<cplx>(sc, coarser_ratio, it->point.p);
       } else {
-        guess = hopf_start(s, st.w, c.ubar_guess, c.omega_guess);
+        guess = krylov_start(s, st.w, c.ubar_guess, c.omega_guess, fill);
         guess.mu = c.ubar_guess;
       }
       const double start_seconds = seconds_since(t0);
@@ -344,7 +366,7 @@ boundary arclength_boundary(const structural_case& c, const grid_level& g, const
   const double m0 = machs.front();
   const auto s0 = make_system(g, m0, c.mu_s);
   const auto st0 = steady(s0);
-  hopf_point guess = hopf_start(s0, st0.w, c.ubar_guess, c.omega_guess);
+  hopf_point guess = krylov_start(s0, st0.w, c.ubar_guess, c.omega_guess, o.fill);
   guess.mu = c.ubar_guess;
   const auto first = hopf_at(s0, m0, st0, guess, o.fill, c.name + " " + g.name + " start");
   require(first.has_value(), "no Hopf point at the start Mach number ", m0);
@@ -555,7 +577,7 @@ void reduced_part(const options& o, const std::map<std::string, boundary>& all) 
   } else {
     std::cout << "  (no " << c.name << " " << g.name << " boundary point at M = " << mach
               << " in this run: inverse-power start)\n";
-    guess = hopf_start(s, st.w, c.ubar_guess, c.omega_guess);
+    guess = krylov_start(s, st.w, c.ubar_guess, c.omega_guess, o.fill);
   }
   guess.w = st.w;
   hopf_krylov_options hk;

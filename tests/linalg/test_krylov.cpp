@@ -251,6 +251,21 @@ TEST(Krylov, SolverWrapperMatchesDirectSolver) {
   direct_solver<Eigen::SparseMatrix<cd>> dc;
   dc.compute(sc);
   EXPECT_LT((itc.solve(bc) - dc.solve(bc)).norm(), 1e-6 * bc.norm());
+  // preconditioner of another matrix (precondition_with: e.g. the modified-order Jacobian),
+  // operator exact: the solution is the operator's; a size mismatch is an input error
+  {
+    krylov_solver_options o;
+    o.krylov.relative_tolerance = 1e-12;
+    krylov_solver<Eigen::SparseMatrix<double>, 4> pw(o);
+    Eigen::SparseMatrix<double> approx = s;
+    for (int k = 0; k < approx.outerSize(); ++k)
+      for (Eigen::SparseMatrix<double>::InnerIterator it(approx, k); it; ++it)
+        if (it.row() != it.col()) it.valueRef() *= 0.8;  // a cruder matrix of the same pattern
+    pw.precondition_with(approx);
+    pw.compute(s);
+    EXPECT_LT((vec<double>(pw.solve(b)) - x_ref).norm(), 1e-9 * x_ref.norm());
+    EXPECT_THROW(pw.compute(Eigen::SparseMatrix<double>(8, 8)), input_error);
+  }
   // non-convergence throws
   krylov_solver_options few;
   few.fill_level = 0;

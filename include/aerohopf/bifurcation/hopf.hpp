@@ -101,18 +101,32 @@ hopf_normalisation resolve_normalisation(hopf_normalisation requested) {
   return is_sparse_matrix_v<M> ? hopf_normalisation::largest_component : hopf_normalisation::eigenvector;
 }
 
-/// Start point for the Hopf Newton iteration: inverse power at (w, mu) with shift i omega_guess.
-template <dynamical_system S>
-hopf_point hopf_start(const S& sys, const vec<double>& w, double mu, double omega_guess,
-                      const inverse_power_options& ipo = {}) {
-  check_state(sys, w, mu, "hopf_start");
-  const eigen_pair ep = inverse_power(sys.jacobian(w, mu), {0.0, omega_guess}, ipo);
+namespace internal {
+inline hopf_point hopf_point_from(const vec<double>& w, double mu, const eigen_pair& ep) {
   hopf_point h{w, mu, ep.lambda.imag(), ep.vector};
   if (h.omega < 0) {
     h.omega = -h.omega;
     h.p = h.p.conjugate().eval();
   }
   return h;
+}
+}  // namespace internal
+
+/// Start point for the Hopf Newton iteration: inverse power at (w, mu) with shift i omega_guess.
+template <dynamical_system S>
+hopf_point hopf_start(const S& sys, const vec<double>& w, double mu, double omega_guess,
+                      const inverse_power_options& ipo = {}) {
+  check_state(sys, w, mu, "hopf_start");
+  return internal::hopf_point_from(w, mu, inverse_power(sys.jacobian(w, mu), {0.0, omega_guess}, ipo));
+}
+
+/// The same with a solver for A - i omega_guess I (inverse_power.hpp), e.g. complex BILU(k) +
+/// GMRES (krylov_solver) for CFD sizes.
+template <dynamical_system S, class Solver>
+hopf_point hopf_start(const S& sys, const vec<double>& w, double mu, double omega_guess,
+                      const inverse_power_options& ipo, Solver& solver) {
+  check_state(sys, w, mu, "hopf_start");
+  return internal::hopf_point_from(w, mu, inverse_power(sys.jacobian(w, mu), {0.0, omega_guess}, ipo, nullptr, solver));
 }
 
 /// Newton on the augmented system from a guess (w, mu, omega, p of any normalisation).

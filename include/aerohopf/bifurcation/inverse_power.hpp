@@ -15,6 +15,16 @@
 // Convergence: ||A x - lambda x||_2 <= max(tolerance max(1, |lambda|), 100 eps ||A||_inf) with
 // ||x||_2 = 1: the residual cannot drop below about eps ||A|| (stiff discretisations have a
 // large ||A||, e.g. 1/h^2).
+//
+// Solver: the shifted matrix is factored by direct_solver (sparse or dense LU) unless a solver
+// of the same compute/solve interface is passed: krylov_solver<Eigen::SparseMatrix<complex>, B>
+// (complex BILU(k) of A - sigma I + GMRES, linalg/krylov_solver.hpp) is the route for CFD
+// sizes, whose LU fills in beyond memory (krylov_solver::precondition_with: BILU of the
+// cheaper modified-order L - sigma I, operator exact). Its solves are inexact (relative
+// tolerance tau of the Krylov options). The residual test above is evaluated exactly, so a
+// returned pair always meets the stated tolerance, but inexact inverse iteration with a FIXED
+// tau stagnates at a residual of order tau ||A||-ish: measured on the medium aerofoil grid,
+// tau = 1e-4 stalls at 2e-6, so tau must be set below the outer tolerance (1e-8 for 1e-8).
 #include <Eigen/Core>
 
 #include <algorithm>
@@ -40,6 +50,7 @@ struct eigen_pair {
   vec<std::complex<double>> vector;  ///< unit 2-norm, largest component real and positive
   int iterations = 0;
   double residual = 0;  ///< ||A x - lambda x||_2
+  long linear_iterations = 0;  ///< Krylov iterations over all solves (0 with a direct solver)
 };
 
 namespace internal {
@@ -62,17 +73,15 @@ inline vec<std::complex<double>> default_start(Eigen::Index n) {
   return x.normalized();
 }
 
-template <class Matrix>
+template <class Matrix, class Solver>
 eigen_pair inverse_power_impl(const Matrix& a, std::complex<double> shift, const inverse_power_options& opt,
-                              const vec<std::complex<double>>* start, const char* who) {
+                              const vec<std::complex<double>>* start, const char* who, Solver& solver) {
   using C = std::complex<double>;
   require(a.rows() == a.cols(), who, ": matrix is ", a.rows(), "x", a.cols(), ", not square");
   require(!start || start->size() == a.rows(), who, ": start vector has ", start ? start->size() : 0,
           " entries, matrix ", a.rows());
   // A shift that is an eigenvalue to working precision (e.g. the exact i omega at a Hopf point)
   // makes A - sigma I singular; inverse power only needs it invertible, so nudge the shift.
-  using shifted_type = decltype(shifted(a, shift));
-  direct_solver<shifted_type> solver(std::string(who) + " (A - sigma I)");
   for (int attempt = 0;; ++attempt) {
     try {
       solver.compute(shifted(a, shift));
@@ -100,6 +109,7 @@ eigen_pair inverse_power_impl(const Matrix& a, std::complex<double> shift, const
   eigen_pair r;
   for (int t = 1; t <= opt.max_iterations; ++t) {
     const vec<C> y = solver.solve(x);
+    if constexpr (requires { solver.last_report().iterations; }) r.linear_iterations += solver.last_report().iterations;
     const double ny2 = y.squaredNorm();
     if (!(ny2 > 0) || !std::isfinite(ny2))
       throw convergence_error(internal::concat(who, ": iterate ", t, " is zero or not finite"));
@@ -123,11 +133,21 @@ eigen_pair inverse_power_impl(const Matrix& a, std::complex<double> shift, const
 
 }  // namespace internal
 
-/// Eigenpair of A whose eigenvalue is nearest shift.
+/// Eigenpair of A whose eigenvalue is nearest shift (sparse or dense LU of A - shift I).
 template <class Matrix>
 eigen_pair inverse_power(const Matrix& a, std::complex<double> shift, const inverse_power_options& opt = {},
                          const vec<std::complex<double>>* start = nullptr) {
-  return internal::inverse_power_impl(a, shift, opt, start, "inverse power");
+  direct_solver<decltype(shifted(a, shift))> solver("inverse power (A - sigma I)");
+  return internal::inverse_power_impl(a, shift, opt, start, "inverse power", solver);
+}
+
+/// The same with a solver of the compute/solve interface for A - shift I (file comment), e.g.
+///   krylov_solver<Eigen::SparseMatrix<std::complex<double>>, 4> s(opts, "inverse power");
+///   inverse_power(A, {0, omega}, {}, nullptr, s);
+template <class Matrix, class Solver>
+eigen_pair inverse_power(const Matrix& a, std::complex<double> shift, const inverse_power_options& opt,
+                         const vec<std::complex<double>>* start, Solver& solver) {
+  return internal::inverse_power_impl(a, shift, opt, start, "inverse power", solver);
 }
 
 /// Adjoint eigenpair: eigenvector q of A^T for the eigenvalue nearest conj(shift). For the
@@ -136,7 +156,8 @@ template <class Matrix>
 eigen_pair inverse_power_adjoint(const Matrix& a, std::complex<double> shift, const inverse_power_options& opt = {},
                                  const vec<std::complex<double>>* start = nullptr) {
   const Matrix at = a.transpose();
-  return internal::inverse_power_impl(at, std::conj(shift), opt, start, "adjoint inverse power");
+  direct_solver<decltype(shifted(at, shift))> solver("adjoint inverse power (A^T - sigma I)");
+  return internal::inverse_power_impl(at, std::conj(shift), opt, start, "adjoint inverse power", solver);
 }
 
 }  // namespace aerohopf
