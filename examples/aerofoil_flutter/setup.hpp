@@ -54,13 +54,16 @@ inline const aerohopf::flow::multiblock_grid<2>& fine_grid() {
   return g;
 }
 
-/// The coupled Euler / pitch-plunge system of spec 05 on grid level g at Mach number `mach`.
-inline aerofoil_system make_system(const grid_level& g, double mach, double mu_s) {
+/// The coupled Euler / pitch-plunge system of spec 05 on grid level g at Mach number `mach`
+/// (contact_smoothing: euler_options::contact_smoothing, 0 = the exact Osher switches).
+inline aerofoil_system make_system(const grid_level& g, double mach, double mu_s, double contact_smoothing = 0.0) {
   aerohopf::structure::pitch_plunge_parameters p;
   p.mu_s = mu_s;
-  return aerofoil_system(
-      aerohopf::flow::euler_model<2>(aerohopf::flow::coarsen(fine_grid(), g.stride), {.mach = mach, .alpha_rad = 0.0}),
-      aerohopf::structure::pitch_plunge(p));
+  aerohopf::flow::euler_options fo;
+  fo.contact_smoothing = contact_smoothing;
+  return aerofoil_system(aerohopf::flow::euler_model<2>(aerohopf::flow::coarsen(fine_grid(), g.stride),
+                                                         {.mach = mach, .alpha_rad = 0.0}, fo),
+                         aerohopf::structure::pitch_plunge(p));
 }
 
 inline std::string fixed(double x, int digits) {
