@@ -76,7 +76,8 @@
 // of Ubar(M) at a kink, M = 0.8850 coarse grid, only fixed M crosses) -- and accepted if it
 // lands within kink_distance x step of the last point and ahead along the secant. A corrected point that goes back along the secant
 // (possible after the exact-tangent retry at a kink: measured, the trace reversed at M = 0.867
-// and retraced the curve) is rejected like a sheet jump.
+// and retraced the curve) is rejected like a sheet jump, and so is one (also of the fallback)
+// within a quarter step of the polyline of the points traced before the last three.
 // Nested steady solves that fail from the extrapolated start are retried from the nearest
 // solved equilibrium and then from equilibrium_start(nu) if given (transonic flow: the shock
 // moves fast with M, and Newton from the extrapolation can meet non-physical states).
@@ -582,6 +583,23 @@ symmetric_hopf_curve_result trace_symmetric_hopf_curve(const F& family, double n
   if (std::isfinite(opt.mu_min)) lands.push_back({0, opt.mu_min, true});
   if (std::isfinite(opt.mu_max)) lands.push_back({0, opt.mu_max, true});
 
+  // Retrace test: y of xx within a quarter step (metric) of the polyline of the points traced
+  // before the last three (a step that turned back at a kink and runs over the curve again).
+  auto revisits = [&](const vec<double>& xx, double step) {
+    const std::size_t m = res.points.size();
+    if (m < 5) return false;
+    auto yp = [&](const hopf_curve_point& p) { return Eigen::Vector3d(p.mu, p.nu, p.omega); };
+    Eigen::Vector3d w3(sig[0] > 0 ? 1 / sig[0] : 0.0, sig[1] > 0 ? 1 / sig[1] : 0.0, sig[2] > 0 ? 1 / sig[2] : 0.0);
+    const Eigen::Vector3d y = Eigen::Vector3d(xx[imu], xx[inu], xx[iom]).cwiseProduct(w3);
+    for (std::size_t k = opt.detect_closed ? 1 : 0; k + 4 < m; ++k) {  // closing on the start: detect_closed
+      const Eigen::Vector3d a = yp(res.points[k]).cwiseProduct(w3), b = yp(res.points[k + 1]).cwiseProduct(w3);
+      const Eigen::Vector3d ab = b - a;
+      const double l2 = ab.squaredNorm();
+      const double th = l2 > 0 ? std::clamp((y - a).dot(ab) / l2, 0.0, 1.0) : 0.0;
+      if ((y - a - th * ab).norm() < 0.25 * step) return true;
+    }
+    return false;
+  };
   const vec<double> x_first = x;
   vec<double> x_prev;
   double ds = std::min(opt.step, opt.max_step), arclength = 0;
@@ -613,6 +631,9 @@ symmetric_hopf_curve_result trace_symmetric_hopf_curve(const F& family, double n
         } else if (!(ydot(d, t_secant) > 0)) {
           // after the exact-tangent retry at a kink: a step back along the traced curve
           last_failure = "the corrected point goes back along the traced curve";
+          xn.reset();
+        } else if (revisits(xn->x, ds)) {
+          last_failure = "the corrected point lies on a stretch of the curve traced before";
           xn.reset();
         }
       }
@@ -650,7 +671,7 @@ symmetric_hopf_curve_result trace_symmetric_hopf_curve(const F& family, double n
           auto xk = correct(xp, s, c, yv(xp, j));
           if (xk) {
             const double dist = ydist(xk->x, x);
-            const bool forward = ydot(vec<double>(xk->x - x), t_secant) > 0;
+            const bool forward = ydot(vec<double>(xk->x - x), t_secant) > 0 && !revisits(xk->x, ds);
             if (forward && dist <= sopt.kink_distance * ds) {
               xn = std::move(xk);
               ++res.kink_steps;
