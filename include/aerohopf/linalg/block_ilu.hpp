@@ -180,8 +180,9 @@ class block_ilu {
         prev = c;
       }
       next[prev] = -1;
-      // eliminate with the rows k < i in increasing order
-      for (int k = next[head]; k != -1 && k < i; k = next[k]) {
+      // eliminate with the rows k < i in increasing order (no fill at all for k = 0: every
+      // update has level >= 1)
+      for (int k = k_fill > 0 ? next[head] : -1; k != -1 && k < i; k = next[k]) {
         const int lik = lev[k];
         int cur = k;  // columns of U row k increase, so each search resumes where the last ended
         for (int u = diag_[k] + 1; u < row_ptr_[k + 1]; ++u) {
@@ -229,6 +230,15 @@ class block_ilu {
           const auto first = col_.begin() + row_ptr_[ni], last = col_.begin() + row_ptr_[ni + 1];
           source_[p] = slot_[std::lower_bound(first, last, nj) - col_.begin()];
         }
+    // factor blocks that no matrix block initialises (fill-in): zeroed before each elimination
+    {
+      std::vector<char> sourced(col_.size(), 0);
+      for (int sl : source_)
+        if (sl >= 0) sourced[sl] = 1;
+      fill_slots_.clear();
+      for (std::size_t sl = 0; sl < sourced.size(); ++sl)
+        if (!sourced[sl]) fill_slots_.push_back(static_cast<int>(sl));
+    }
     val_.assign(col_.size() * bs_ * bs_, Scalar(0.0));
     pos_.assign(n, -1);
     work_.resize(static_cast<index>(n) * bs_);
@@ -244,13 +254,15 @@ class block_ilu {
             " block rows, ", a.nonzero_blocks(), " blocks vs ", n_, ", ", a_col_.size(), ")");
     factorized_ = false;
     const index bb = bs_ * bs_;
-    std::fill(val_.begin(), val_.end(), Scalar(0.0));
+    for (int sl : fill_slots_) std::fill_n(val_.data() + index(sl) * bb, bb, Scalar(0.0));
     const auto& av = a.values();
     for (int i = 0; i < n_; ++i)
       for (int p = a_row_ptr_[i]; p < a_row_ptr_[i + 1]; ++p) {
         const Scalar* src = av.data() + index(p) * bb;
         bool finite = true;
-        for (index e = 0; e < bb; ++e) finite = finite && std::isfinite(std::abs(src[e]));
+        if constexpr (internal::has_fast_block_kernel_v<Scalar, B>) finite = internal::all_finite<B * B>(src);
+        else
+          for (index e = 0; e < bb; ++e) finite = finite && std::isfinite(std::abs(src[e]));
         if (!finite)
           throw input_error(internal::concat(opt_.context, ": matrix block (", i, ", ", a_col_[p],
                                              ") has a non-finite entry (NaN or Inf)"));
@@ -259,6 +271,30 @@ class block_ilu {
 
     const index b = bs_;
     block_type tmp(b, b);
+    if constexpr (internal::has_fast_block_kernel_v<Scalar, B>) {
+      // the same elimination with the hand-written block products (no __muldc3 for complex)
+      constexpr int bb2 = B * B;
+      Scalar t[bb2];
+      Scalar* v = val_.data();
+      for (int i = 0; i < n_; ++i) {
+        for (int q = row_ptr_[i]; q < row_ptr_[i + 1]; ++q) pos_[col_[q]] = q;
+        for (int q = row_ptr_[i]; q < diag_[i]; ++q) {
+          const int k = col_[q];
+          Scalar* lik = v + index(slot_[q]) * bb2;
+          std::copy(lik, lik + bb2, t);
+          std::fill(lik, lik + bb2, Scalar(0.0));
+          internal::block_gemm<1, B>(t, v + index(slot_[diag_[k]]) * bb2, lik);  // L_ik = C_ik U_kk^{-1}
+          for (int u = diag_[k] + 1; u < row_ptr_[k + 1]; ++u) {
+            const int tq = pos_[col_[u]];
+            if (tq >= 0) internal::block_gemm<-1, B>(lik, v + index(slot_[u]) * bb2, v + index(slot_[tq]) * bb2);
+          }
+        }
+        for (int q = row_ptr_[i]; q < row_ptr_[i + 1]; ++q) pos_[col_[q]] = -1;
+        invert_pivot(i);
+      }
+      factorized_ = true;
+      return;
+    }
     for (int i = 0; i < n_; ++i) {
       for (int q = row_ptr_[i]; q < row_ptr_[i + 1]; ++q) pos_[col_[q]] = q;
       for (int q = row_ptr_[i]; q < diag_[i]; ++q) {
@@ -284,11 +320,14 @@ class block_ilu {
             z.size(), ", expected ", rows());
     const index b = bs_;
     Scalar* w = perm_.empty() ? z.data() : work_.data();
-    if (perm_.empty()) z = r;
-    else
+    constexpr bool fast = internal::has_fast_block_kernel_v<Scalar, B>;
+    if (!perm_.empty())
       for (int i = 0; i < n_; ++i)
         Eigen::Map<segment_type>(w + index(i) * b, b) = r.template segment<B>(index(perm_[i]) * b, b);
-    if constexpr (internal::has_fast_block_kernel_v<Scalar, B>) {
+    else if (!fast)
+      z = r;  // the fast forward sweep reads r itself (one vector pass less)
+    if constexpr (fast) {
+      const Scalar* rin = perm_.empty() ? r.data() : w;
       const Scalar* v = val_.data();
       const int* rp = row_ptr_.data();
       const int* dg = diag_.data();
@@ -297,9 +336,11 @@ class block_ilu {
       for (int i = 0; i < n_; ++i) {  // forward: L y = r (unit block diagonal)
         Scalar acc[B];
         Scalar* wi = w + index(i) * B;
-        for (int r = 0; r < B; ++r) acc[r] = wi[r];
+        const Scalar* ri = rin + index(i) * B;
+        for (int r = 0; r < B; ++r) acc[r] = ri[r];
         const Scalar* lv = v + index(sl[rp[i]]) * B * B;  // L part of row i is contiguous
-        for (int q = rp[i]; q < dg[i]; ++q, lv += B * B) internal::block_gemv<-1, B>(lv, w + index(cl[q]) * B, acc);
+        internal::prefetch_ahead(lv, index(dg[i] - rp[i]) * B * B * index(sizeof(Scalar)));
+        internal::block_row_gemv<-1, B>(lv, cl + rp[i], dg[i] - rp[i], w, acc);
         for (int r = 0; r < B; ++r) wi[r] = acc[r];
       }
       for (int i = n_ - 1; i >= 0; --i) {  // backward: U x = y, diagonal stored inverted
@@ -307,8 +348,8 @@ class block_ilu {
         Scalar* wi = w + index(i) * B;
         for (int r = 0; r < B; ++r) acc[r] = wi[r];
         const Scalar* uv = v + index(sl[dg[i]]) * B * B;  // diagonal, then the U part of row i
-        for (int q = dg[i] + 1; q < rp[i + 1]; ++q)
-          internal::block_gemv<-1, B>(uv + (q - dg[i]) * B * B, w + index(cl[q]) * B, acc);
+        internal::prefetch_ahead(uv, index(rp[i + 1] - dg[i]) * B * B * index(sizeof(Scalar)));
+        internal::block_row_gemv<-1, B>(uv + B * B, cl + dg[i] + 1, rp[i + 1] - dg[i] - 1, w, acc);
         Scalar out[B];
         for (int r = 0; r < B; ++r) out[r] = Scalar(0.0);
         internal::block_gemv<1, B>(uv, acc, out);
@@ -355,6 +396,19 @@ class block_ilu {
   void invert_pivot(int i) {
     block_map d = blk(diag_[i]);
     const int orig = perm_.empty() ? i : perm_[i];
+    if constexpr (internal::has_fast_block_kernel_v<Scalar, B>) {
+      if (!internal::all_finite<B * B>(d.data()))
+        throw singular_matrix_error(internal::concat(opt_.context, ": pivot block of block row ", orig,
+                                                     " became non-finite during the elimination"));
+      block_type keep = d;
+      const double rc = internal::invert_block<B>(d.data());
+      if (!(rc > opt_.pivot_rcond_tolerance)) {
+        d = keep;
+        throw singular_matrix_error(internal::concat(opt_.context, ": pivot block of block row ", orig,
+                                                     " is singular (reciprocal condition ", rc, ")"));
+      }
+      return;
+    }
     if (!d.allFinite())
       throw singular_matrix_error(internal::concat(opt_.context, ": pivot block of block row ", orig,
                                                    " became non-finite during the elimination"));
@@ -372,7 +426,7 @@ class block_ilu {
   int n_ = 0;
   std::vector<int> a_row_ptr_, a_col_;  // pattern of the analysed matrix
   std::vector<int> perm_, inv_;
-  std::vector<int> row_ptr_, col_, diag_, source_, slot_;
+  std::vector<int> row_ptr_, col_, diag_, source_, slot_, fill_slots_;
   std::vector<Scalar> val_;
   std::vector<int> pos_;
   mutable vector_type work_;

@@ -4,18 +4,37 @@
 // WHY hand-written loops instead of Eigen fixed-size products: for std::complex<double> without
 // -ffast-math every complex product goes through the C99 NaN/Inf-checking path (__muldc3), which
 // made complex SpMV 2-3x slower than the memory traffic allows; spelling the complex product in
-// real arithmetic on the interleaved (re, im) storage avoids that, and for real blocks the plain
-// column loop with a compile-time B unrolls and vectorises at least as well. Other scalars
-// (dd_real, runtime block size) fall back to Eigen.
+// real arithmetic on the interleaved (re, im) storage avoids that. Other scalars (dd_real,
+// runtime block size) fall back to Eigen in the callers.
 //
-// Blocks are column-major B x B; acc (+|-)= A x.
+// The unit of work is a block ROW: acc (+|-)= sum_q A_q x_{col_q} over the consecutive blocks A_q
+// of one row. A `row_accumulator` keeps the partial sums in registers across all blocks of the
+// row, so the accumulator is loaded and stored once per row, not once per block.
+//
+// Instruction sets: with AVX2 + FMA (compile with -march=native, the CMake option
+// AEROHOPF_NATIVE) the B = 4 and B = 5 kernels use 256-bit fused multiply-adds with two or more
+// independent accumulators (the FMA latency, not the memory, would otherwise bound a 5 x 5 real
+// block). The fused products are written as intrinsics on purpose: the library compiles with
+// -ffp-contract=off (QD needs exact IEEE rounding of every operation), so the compiler never
+// fuses these itself. The complex kernels accumulate A x_re and A x_im separately and combine
+// them once per row with one add-subtract (no shuffles in the inner loop). Without AVX2 the
+// real kernels are plain unrolled loops and the complex ones SSE2.
+//
+// Blocks are column-major B x B.
 #include <Eigen/Core>
 
+#include <cmath>
 #include <complex>
+#include <cstddef>
+#include <utility>
 #include <type_traits>
 
 #if defined(__SSE2__)
 #include <emmintrin.h>
+#endif
+#if defined(__AVX2__) && defined(__FMA__)
+#include <immintrin.h>
+#define AEROHOPF_AVX2_BLOCK_KERNELS 1
 #endif
 
 namespace aerohopf::internal {
@@ -24,56 +43,326 @@ template <class S, int B>
 inline constexpr bool has_fast_block_kernel_v =
     B != Eigen::Dynamic && (std::is_same_v<S, double> || std::is_same_v<S, std::complex<double>>);
 
-/// acc += sign * A x for a B x B column-major block a (Sign = +1 or -1).
-template <int Sign, int B>
-inline void block_gemv(const double* __restrict a, const double* __restrict x, double* __restrict acc) {
-  double t[B] = {};
-  for (int c = 0; c < B; ++c) {
-    const double xc = x[c];
-    for (int r = 0; r < B; ++r) t[r] += a[c * B + r] * xc;
-  }
-  for (int r = 0; r < B; ++r) acc[r] += Sign > 0 ? t[r] : -t[r];
+/// Which kernel family this translation unit compiled (for benchmark labels and tests).
+inline constexpr const char* block_kernel_isa() {
+#if defined(AEROHOPF_AVX2_BLOCK_KERNELS)
+  return "avx2-fma";
+#elif defined(__SSE2__)
+  return "sse2";
+#else
+  return "scalar";
+#endif
 }
 
-template <int Sign, int B>
-inline void block_gemv(const std::complex<double>* __restrict ac, const std::complex<double>* __restrict xc,
-                       std::complex<double>* __restrict accc) {
-  // std::complex<double> is layout-compatible with double[2]
-  const double* a = reinterpret_cast<const double*>(ac);
-  const double* x = reinterpret_cast<const double*>(xc);
-  double* acc = reinterpret_cast<double*>(accc);
+/// Partial sums of one block row: add(a, x) accumulates the B x B block a times the segment x;
+/// finish<Sign>(acc) does acc += Sign * sum. The primary template is the portable version.
+template <class S, int B>
+struct row_accumulator {
+  static_assert(std::is_same_v<S, double>, "row_accumulator: double and std::complex<double> only");
+  double t[B] = {};
+  inline void add(const double* __restrict a, const double* __restrict x) {
+    for (int c = 0; c < B; ++c) {
+      const double xc = x[c];
+      for (int r = 0; r < B; ++r) t[r] += a[c * B + r] * xc;
+    }
+  }
+  template <int Sign>
+  inline void finish(double* __restrict acc) const {
+    for (int r = 0; r < B; ++r) acc[r] += Sign > 0 ? t[r] : -t[r];
+  }
+};
+
+template <int B>
+struct row_accumulator<std::complex<double>, B> {
 #if defined(__SSE2__)
   // one (re, im) register per block row: t += (ar, ai) * xr + (ai, ar) * (-xi, xi)
   __m128d t[B];
-  for (int r = 0; r < B; ++r) t[r] = _mm_setzero_pd();
-  for (int c = 0; c < B; ++c) {
-    const __m128d xr = _mm_set1_pd(x[2 * c]);
-    const __m128d xi = _mm_set_pd(x[2 * c + 1], -x[2 * c + 1]);
-    for (int r = 0; r < B; ++r) {
-      const __m128d av = _mm_loadu_pd(a + 2 * (c * B + r));
-      const __m128d as = _mm_shuffle_pd(av, av, 1);
-      t[r] = _mm_add_pd(t[r], _mm_add_pd(_mm_mul_pd(av, xr), _mm_mul_pd(as, xi)));
+  row_accumulator() {
+    for (int r = 0; r < B; ++r) t[r] = _mm_setzero_pd();
+  }
+  inline void add(const std::complex<double>* __restrict ac, const std::complex<double>* __restrict xc) {
+    const double* a = reinterpret_cast<const double*>(ac);  // layout-compatible with double[2]
+    const double* x = reinterpret_cast<const double*>(xc);
+    for (int c = 0; c < B; ++c) {
+      const __m128d xr = _mm_set1_pd(x[2 * c]);
+      const __m128d xi = _mm_set_pd(x[2 * c + 1], -x[2 * c + 1]);
+      for (int r = 0; r < B; ++r) {
+        const __m128d av = _mm_loadu_pd(a + 2 * (c * B + r));
+        const __m128d as = _mm_shuffle_pd(av, av, 1);
+        t[r] = _mm_add_pd(t[r], _mm_add_pd(_mm_mul_pd(av, xr), _mm_mul_pd(as, xi)));
+      }
     }
   }
-  for (int r = 0; r < B; ++r) {
-    const __m128d old = _mm_loadu_pd(acc + 2 * r);
-    _mm_storeu_pd(acc + 2 * r, Sign > 0 ? _mm_add_pd(old, t[r]) : _mm_sub_pd(old, t[r]));
+  template <int Sign>
+  inline void finish(std::complex<double>* __restrict accc) const {
+    double* acc = reinterpret_cast<double*>(accc);
+    for (int r = 0; r < B; ++r) {
+      const __m128d old = _mm_loadu_pd(acc + 2 * r);
+      _mm_storeu_pd(acc + 2 * r, Sign > 0 ? _mm_add_pd(old, t[r]) : _mm_sub_pd(old, t[r]));
+    }
   }
 #else
   double re[B] = {}, im[B] = {};
-  for (int c = 0; c < B; ++c) {
-    const double xr = x[2 * c], xi = x[2 * c + 1];
-    for (int r = 0; r < B; ++r) {
-      const double ar = a[2 * (c * B + r)], ai = a[2 * (c * B + r) + 1];
-      re[r] += ar * xr - ai * xi;
-      im[r] += ar * xi + ai * xr;
+  inline void add(const std::complex<double>* __restrict ac, const std::complex<double>* __restrict xc) {
+    const double* a = reinterpret_cast<const double*>(ac);
+    const double* x = reinterpret_cast<const double*>(xc);
+    for (int c = 0; c < B; ++c) {
+      const double xr = x[2 * c], xi = x[2 * c + 1];
+      for (int r = 0; r < B; ++r) {
+        const double ar = a[2 * (c * B + r)], ai = a[2 * (c * B + r) + 1];
+        re[r] += ar * xr - ai * xi;
+        im[r] += ar * xi + ai * xr;
+      }
     }
   }
-  for (int r = 0; r < B; ++r) {
-    acc[2 * r] += Sign > 0 ? re[r] : -re[r];
-    acc[2 * r + 1] += Sign > 0 ? im[r] : -im[r];
+  template <int Sign>
+  inline void finish(std::complex<double>* __restrict accc) const {
+    double* acc = reinterpret_cast<double*>(accc);
+    for (int r = 0; r < B; ++r) {
+      acc[2 * r] += Sign > 0 ? re[r] : -re[r];
+      acc[2 * r + 1] += Sign > 0 ? im[r] : -im[r];
+    }
   }
 #endif
+};
+
+#if defined(AEROHOPF_AVX2_BLOCK_KERNELS)
+// ---- AVX2 + FMA: real 4 x 4 (one column = one register, two accumulators) -------------------
+template <>
+struct row_accumulator<double, 4> {
+  __m256d t0 = _mm256_setzero_pd(), t1 = _mm256_setzero_pd();
+  inline void add(const double* __restrict a, const double* __restrict x) {
+    t0 = _mm256_fmadd_pd(_mm256_loadu_pd(a), _mm256_broadcast_sd(x), t0);
+    t1 = _mm256_fmadd_pd(_mm256_loadu_pd(a + 4), _mm256_broadcast_sd(x + 1), t1);
+    t0 = _mm256_fmadd_pd(_mm256_loadu_pd(a + 8), _mm256_broadcast_sd(x + 2), t0);
+    t1 = _mm256_fmadd_pd(_mm256_loadu_pd(a + 12), _mm256_broadcast_sd(x + 3), t1);
+  }
+  template <int Sign>
+  inline void finish(double* __restrict acc) const {
+    const __m256d s = _mm256_add_pd(t0, t1), old = _mm256_loadu_pd(acc);
+    _mm256_storeu_pd(acc, Sign > 0 ? _mm256_add_pd(old, s) : _mm256_sub_pd(old, s));
+  }
+};
+
+// ---- real 5 x 5: rows 0-3 of a column in a register, row 4 as a scalar fused multiply-add ----
+template <>
+struct row_accumulator<double, 5> {
+  __m256d t0 = _mm256_setzero_pd(), t1 = _mm256_setzero_pd();
+  __m128d s0 = _mm_setzero_pd(), s1 = _mm_setzero_pd();
+  inline void add(const double* __restrict a, const double* __restrict x) {
+    const __m256d x0 = _mm256_broadcast_sd(x), x1 = _mm256_broadcast_sd(x + 1), x2 = _mm256_broadcast_sd(x + 2),
+                  x3 = _mm256_broadcast_sd(x + 3), x4 = _mm256_broadcast_sd(x + 4);
+    t0 = _mm256_fmadd_pd(_mm256_loadu_pd(a), x0, t0);
+    t1 = _mm256_fmadd_pd(_mm256_loadu_pd(a + 5), x1, t1);
+    t0 = _mm256_fmadd_pd(_mm256_loadu_pd(a + 10), x2, t0);
+    t1 = _mm256_fmadd_pd(_mm256_loadu_pd(a + 15), x3, t1);
+    t0 = _mm256_fmadd_pd(_mm256_loadu_pd(a + 20), x4, t0);
+    s0 = _mm_fmadd_sd(_mm_load_sd(a + 4), _mm256_castpd256_pd128(x0), s0);
+    s1 = _mm_fmadd_sd(_mm_load_sd(a + 9), _mm256_castpd256_pd128(x1), s1);
+    s0 = _mm_fmadd_sd(_mm_load_sd(a + 14), _mm256_castpd256_pd128(x2), s0);
+    s1 = _mm_fmadd_sd(_mm_load_sd(a + 19), _mm256_castpd256_pd128(x3), s1);
+    s0 = _mm_fmadd_sd(_mm_load_sd(a + 24), _mm256_castpd256_pd128(x4), s0);
+  }
+  template <int Sign>
+  inline void finish(double* __restrict acc) const {
+    const __m256d s = _mm256_add_pd(t0, t1), old = _mm256_loadu_pd(acc);
+    _mm256_storeu_pd(acc, Sign > 0 ? _mm256_add_pd(old, s) : _mm256_sub_pd(old, s));
+    const double s4 = _mm_cvtsd_f64(_mm_add_sd(s0, s1));
+    acc[4] += Sign > 0 ? s4 : -s4;
+  }
+};
+
+// ---- complex: P = sum A x_re, Q = sum A x_im (interleaved re/im lanes); A x = P + i Q, i.e.
+// (P_re - Q_im, P_im + Q_re) = addsub(P, swap(Q)) once per row.
+inline __m256d avx2_complex_combine(__m256d p, __m256d q) { return _mm256_addsub_pd(p, _mm256_permute_pd(q, 0x5)); }
+
+template <>
+struct row_accumulator<std::complex<double>, 4> {
+  __m256d p0 = _mm256_setzero_pd(), p1 = _mm256_setzero_pd(), q0 = _mm256_setzero_pd(), q1 = _mm256_setzero_pd();
+  inline void add(const std::complex<double>* __restrict ac, const std::complex<double>* __restrict xc) {
+    const double* a = reinterpret_cast<const double*>(ac);
+    const double* x = reinterpret_cast<const double*>(xc);
+    for (int c = 0; c < 4; ++c) {
+      const __m256d xr = _mm256_broadcast_sd(x + 2 * c), xi = _mm256_broadcast_sd(x + 2 * c + 1);
+      const __m256d a0 = _mm256_loadu_pd(a + 8 * c), a1 = _mm256_loadu_pd(a + 8 * c + 4);
+      p0 = _mm256_fmadd_pd(a0, xr, p0);
+      p1 = _mm256_fmadd_pd(a1, xr, p1);
+      q0 = _mm256_fmadd_pd(a0, xi, q0);
+      q1 = _mm256_fmadd_pd(a1, xi, q1);
+    }
+  }
+  template <int Sign>
+  inline void finish(std::complex<double>* __restrict accc) const {
+    double* acc = reinterpret_cast<double*>(accc);
+    const __m256d r0 = avx2_complex_combine(p0, q0), r1 = avx2_complex_combine(p1, q1);
+    const __m256d o0 = _mm256_loadu_pd(acc), o1 = _mm256_loadu_pd(acc + 4);
+    _mm256_storeu_pd(acc, Sign > 0 ? _mm256_add_pd(o0, r0) : _mm256_sub_pd(o0, r0));
+    _mm256_storeu_pd(acc + 4, Sign > 0 ? _mm256_add_pd(o1, r1) : _mm256_sub_pd(o1, r1));
+  }
+};
+
+template <>
+struct row_accumulator<std::complex<double>, 5> {
+  __m256d p0 = _mm256_setzero_pd(), p1 = _mm256_setzero_pd(), q0 = _mm256_setzero_pd(), q1 = _mm256_setzero_pd();
+  __m128d p2 = _mm_setzero_pd(), q2 = _mm_setzero_pd();
+  inline void add(const std::complex<double>* __restrict ac, const std::complex<double>* __restrict xc) {
+    const double* a = reinterpret_cast<const double*>(ac);
+    const double* x = reinterpret_cast<const double*>(xc);
+    for (int c = 0; c < 5; ++c) {
+      const __m256d xr = _mm256_broadcast_sd(x + 2 * c), xi = _mm256_broadcast_sd(x + 2 * c + 1);
+      const __m256d a0 = _mm256_loadu_pd(a + 10 * c), a1 = _mm256_loadu_pd(a + 10 * c + 4);
+      const __m128d a2 = _mm_loadu_pd(a + 10 * c + 8);
+      p0 = _mm256_fmadd_pd(a0, xr, p0);
+      p1 = _mm256_fmadd_pd(a1, xr, p1);
+      p2 = _mm_fmadd_pd(a2, _mm256_castpd256_pd128(xr), p2);
+      q0 = _mm256_fmadd_pd(a0, xi, q0);
+      q1 = _mm256_fmadd_pd(a1, xi, q1);
+      q2 = _mm_fmadd_pd(a2, _mm256_castpd256_pd128(xi), q2);
+    }
+  }
+  template <int Sign>
+  inline void finish(std::complex<double>* __restrict accc) const {
+    double* acc = reinterpret_cast<double*>(accc);
+    const __m256d r0 = avx2_complex_combine(p0, q0), r1 = avx2_complex_combine(p1, q1);
+    const __m128d r2 = _mm_addsub_pd(p2, _mm_permute_pd(q2, 0x1));
+    const __m256d o0 = _mm256_loadu_pd(acc), o1 = _mm256_loadu_pd(acc + 4);
+    const __m128d o2 = _mm_loadu_pd(acc + 8);
+    _mm256_storeu_pd(acc, Sign > 0 ? _mm256_add_pd(o0, r0) : _mm256_sub_pd(o0, r0));
+    _mm256_storeu_pd(acc + 4, Sign > 0 ? _mm256_add_pd(o1, r1) : _mm256_sub_pd(o1, r1));
+    _mm_storeu_pd(acc + 8, Sign > 0 ? _mm_add_pd(o2, r2) : _mm_sub_pd(o2, r2));
+  }
+};
+#endif  // AEROHOPF_AVX2_BLOCK_KERNELS
+
+/// Software prefetch of the bytes [p + distance, p + distance + bytes) of a read-only stream,
+/// one request per 64-byte line. WHY: in the BILU sweeps each row waits for the previous row's
+/// result, which stalls the out-of-order window and with it the hardware prefetchers' lead;
+/// requests issued a few kilobytes ahead keep the memory busy regardless (measured in
+/// bench_linear_solver: SpMV and BILU apply on matrices larger than the last-level cache).
+#ifndef AEROHOPF_PREFETCH_DISTANCE
+#define AEROHOPF_PREFETCH_DISTANCE 8192
+#endif
+#ifndef AEROHOPF_PREFETCH_LOCALITY
+#define AEROHOPF_PREFETCH_LOCALITY 0
+#endif
+inline constexpr std::ptrdiff_t prefetch_distance_bytes = AEROHOPF_PREFETCH_DISTANCE;
+inline void prefetch_ahead(const void* p, std::ptrdiff_t bytes) {
+#if defined(__GNUC__)
+  const char* c = static_cast<const char*>(p) + prefetch_distance_bytes;
+  for (std::ptrdiff_t o = 0; o < bytes; o += 64) __builtin_prefetch(c + o, 0, AEROHOPF_PREFETCH_LOCALITY);
+#else
+  (void)p;
+  (void)bytes;
+#endif
+}
+
+/// acc += Sign * sum_{q < count} A_q x[cols[q]], the blocks A_q stored consecutively from a.
+template <int Sign, int B, class S>
+inline void block_row_gemv(const S* __restrict a, const int* __restrict cols, int count, const S* __restrict x,
+                           S* __restrict acc) {
+  row_accumulator<S, B> t;
+  for (int q = 0; q < count; ++q) t.add(a + static_cast<std::ptrdiff_t>(q) * B * B, x + static_cast<std::ptrdiff_t>(cols[q]) * B);
+  t.template finish<Sign>(acc);
+}
+
+/// acc += Sign * A x for one B x B block.
+template <int Sign, int B, class S>
+inline void block_gemv(const S* __restrict a, const S* __restrict x, S* __restrict acc) {
+  row_accumulator<S, B> t;
+  t.add(a, x);
+  t.template finish<Sign>(acc);
+}
+
+/// c += Sign * a b for B x B column-major blocks (column j of c gets a times column j of b).
+template <int Sign, int B, class S>
+inline void block_gemm(const S* __restrict a, const S* __restrict b, S* __restrict c) {
+  for (int j = 0; j < B; ++j) block_gemv<Sign, B>(a, b + j * B, c + j * B);
+}
+
+/// Product without the C99 NaN/Inf recovery of std::complex operator* (the factorisation checks
+/// finiteness itself), plain product otherwise.
+template <class S>
+inline S plain_mul(const S& a, const S& b) {
+  if constexpr (std::is_same_v<S, std::complex<double>>)
+    return {a.real() * b.real() - a.imag() * b.imag(), a.real() * b.imag() + a.imag() * b.real()};
+  else return a * b;
+}
+
+/// True iff every real component of the N scalars at p is finite (complex: both parts; no
+/// hypot). x * 0 is NaN iff x is NaN or Inf; four independent partial sums.
+template <int N, class S>
+inline bool all_finite(const S* p) {
+  constexpr int m = std::is_same_v<S, std::complex<double>> ? 2 * N : N;
+  const double* d = reinterpret_cast<const double*>(p);
+  double a0 = 0.0, a1 = 0.0, a2 = 0.0, a3 = 0.0;
+  int e = 0;
+  for (; e + 4 <= m; e += 4) {
+    a0 += d[e] * 0.0;
+    a1 += d[e + 1] * 0.0;
+    a2 += d[e + 2] * 0.0;
+    a3 += d[e + 3] * 0.0;
+  }
+  if constexpr (m % 4 != 0)
+    for (; e < m; ++e) a0 += d[e] * 0.0;
+  return (a0 + a1) + (a2 + a3) == 0.0;
+}
+
+/// |Re z| + |Im z| (LAPACK's cabs1): as good as the modulus for pivoting and norms, no hypot.
+template <class S>
+inline double cabs1(const S& z) {
+  if constexpr (std::is_same_v<S, std::complex<double>>) return std::abs(z.real()) + std::abs(z.imag());
+  else return std::abs(z);
+}
+
+/// In-place inverse of a B x B column-major block by Gauss-Jordan elimination with partial
+/// (row) pivoting. Returns the reciprocal 1-norm condition number 1 / (||A||_1 ||A^-1||_1),
+/// exact since the inverse is formed (complex entries measured by cabs1, which changes it by at
+/// most a factor 2), or 0 if a pivot is exactly zero or not finite; a is then unspecified.
+template <int B, class S>
+inline double invert_block(S* __restrict a) {
+  auto abs = [](const S& z) { return cabs1(z); };
+  auto at = [a](int r, int c) -> S& { return a[c * B + r]; };
+  double norm_a = 0.0;
+  for (int c = 0; c < B; ++c) {
+    double s = 0.0;
+    for (int r = 0; r < B; ++r) s += abs(at(r, c));
+    norm_a = s > norm_a ? s : norm_a;
+  }
+  int piv[B];
+  for (int k = 0; k < B; ++k) {
+    int p = k;
+    double best = abs(at(k, k));
+    for (int r = k + 1; r < B; ++r)
+      if (abs(at(r, k)) > best) {
+        best = abs(at(r, k));
+        p = r;
+      }
+    piv[k] = p;
+    if (!(best > 0.0) || !std::isfinite(best)) return 0.0;
+    if (p != k)
+      for (int c = 0; c < B; ++c) std::swap(at(k, c), at(p, c));
+    const S inv = S(1.0) / at(k, k);
+    at(k, k) = S(1.0);
+    for (int c = 0; c < B; ++c) at(k, c) = plain_mul(at(k, c), inv);
+    for (int r = 0; r < B; ++r) {
+      if (r == k) continue;
+      const S f = at(r, k);
+      at(r, k) = S(0.0);
+      for (int c = 0; c < B; ++c) at(r, c) -= plain_mul(f, at(k, c));
+    }
+  }
+  // undo the row interchanges as column interchanges of the inverse, in reverse order
+  for (int k = B - 1; k >= 0; --k)
+    if (piv[k] != k)
+      for (int r = 0; r < B; ++r) std::swap(at(r, k), at(r, piv[k]));
+  double norm_inv = 0.0;
+  for (int c = 0; c < B; ++c) {
+    double s = 0.0;
+    for (int r = 0; r < B; ++r) s += abs(at(r, c));
+    norm_inv = s > norm_inv ? s : norm_inv;
+  }
+  const double rc = 1.0 / (norm_a * norm_inv);
+  return std::isfinite(rc) ? rc : 0.0;
 }
 
 }  // namespace aerohopf::internal

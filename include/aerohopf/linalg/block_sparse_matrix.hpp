@@ -351,8 +351,9 @@ class block_sparse_matrix {
       for (index i = 0; i < nbr_; ++i) {
         Scalar acc[B];
         for (int r = 0; r < B; ++r) acc[r] = Scalar(0.0);
-        for (storage_index p = row_ptr_[i]; p < row_ptr_[i + 1]; ++p)
-          internal::block_gemv<1, B>(v + index(p) * B * B, xv + index(cols[p]) * B, acc);
+        const storage_index p0 = row_ptr_[i];
+        internal::prefetch_ahead(v + index(p0) * B * B, index(row_ptr_[i + 1] - p0) * B * B * index(sizeof(Scalar)));
+        internal::block_row_gemv<1, B>(v + index(p0) * B * B, cols + p0, row_ptr_[i + 1] - p0, xv, acc);
         for (int r = 0; r < B; ++r) {
           if constexpr (Accumulate) yv[i * B + r] += alpha * acc[r];
           else yv[i * B + r] = acc[r];
