@@ -140,6 +140,57 @@ struct symmetric_hopf_problem {
   }
 };
 
+/// The real split form of (A + dmu A_mu) - i omega I acting on v = [x_re; x_im] (n each):
+///   r = [(A + dmu A_mu) x_re + omega x_im;  (A + dmu A_mu) x_im - omega x_re].
+/// A is a padded block matrix (rows() >= n, padding zero); A_mu (any matrix with a product) is
+/// used only when dmu != 0. The inner operator of every bordered Krylov Hopf solve.
+template <class BlockMatrix, class Amu = Eigen::SparseMatrix<double>>
+struct real_split_shifted_operator {
+  const BlockMatrix& a;
+  double omega;
+  Eigen::Index n;
+  const Amu* amu = nullptr;
+  double dmu = 0.0;
+  mutable vec<double> xin, xout, tmp;
+  real_split_shifted_operator(const BlockMatrix& a_, double omega_, Eigen::Index n_, const Amu* amu_ = nullptr,
+                              double dmu_ = 0.0)
+      : a(a_), omega(omega_), n(n_), amu(amu_), dmu(dmu_), xin(vec<double>::Zero(a_.rows())), xout(a_.rows()), tmp(n_) {}
+  void operator()(const vec<double>& v, vec<double>& r) const {
+    xin.head(n) = v.head(n);
+    a.multiply(xin, xout);
+    r.head(n) = xout.head(n);
+    xin.head(n) = v.tail(n);
+    a.multiply(xin, xout);
+    r.tail(n) = xout.head(n);
+    if (dmu != 0.0 && amu) {
+      tmp.noalias() = *amu * v.head(n);
+      r.head(n) += dmu * tmp;
+      tmp.noalias() = *amu * v.tail(n);
+      r.tail(n) += dmu * tmp;
+    }
+    r.head(n) += omega * v.tail(n);
+    r.tail(n) -= omega * v.head(n);
+  }
+};
+
+/// A complex preconditioner of A - i omega I (apply(rc, zc) on padded complex vectors, e.g. the
+/// complex BILU) applied in the real split form [re; im] of real_split_shifted_operator.
+template <class ComplexPreconditioner>
+struct complex_preconditioner_split_form {
+  const ComplexPreconditioner& m;
+  Eigen::Index n;
+  mutable vec<std::complex<double>> rc, zc;
+  complex_preconditioner_split_form(const ComplexPreconditioner& m_, Eigen::Index n_, Eigen::Index padded)
+      : m(m_), n(n_), rc(vec<std::complex<double>>::Zero(padded)), zc(padded) {}
+  void operator()(const vec<double>& r, vec<double>& z) const {
+    rc.head(n).real() = r.head(n);
+    rc.head(n).imag() = r.tail(n);
+    m.apply(rc, zc);
+    z.head(n) = zc.head(n).real();
+    z.tail(n) = zc.head(n).imag();
+  }
+};
+
 }  // namespace internal
 
 /// Newton on the reduced Hopf system by bordering (see the file comment). opt.symmetric must be
@@ -290,33 +341,11 @@ hopf_result solve_hopf_krylov(const S& sys, const hopf_point& guess, const hopf_
       refresh(mu, om);
     last_norm = fn;
     const double dmu = mu - mu0;
-    // inner operator: the real form of A - i omega I on (x_re, x_im), A = A0 + dmu A_mu0
-    vec<double> tmp(n), xin = vec<double>::Zero(padded), xout(padded);
-    auto inner = [&](const vec<double>& v, vec<double>& r) {
-      xin.head(n) = v.head(n);
-      a.multiply(xin, xout);
-      r.head(n) = xout.head(n);
-      xin.head(n) = v.tail(n);
-      a.multiply(xin, xout);
-      r.tail(n) = xout.head(n);
-      if (dmu != 0) {
-        tmp.noalias() = amu * v.head(n);
-        r.head(n) += dmu * tmp;
-        tmp.noalias() = amu * v.tail(n);
-        r.tail(n) += dmu * tmp;
-      }
-      r.head(n) += om * v.tail(n);
-      r.tail(n) -= om * v.head(n);
-    };
-    // its preconditioner: complex BILU solve in the real form
-    vec<C> rc = vec<C>::Zero(padded), zc(padded);
-    auto inner_pre = [&](const vec<double>& r, vec<double>& z) {
-      rc.head(n).real() = r.head(n);
-      rc.head(n).imag() = r.tail(n);
-      ilu.apply(rc, zc);
-      z.head(n) = zc.head(n).real();
-      z.tail(n) = zc.head(n).imag();
-    };
+    // inner operator: the real form of A - i omega I on (x_re, x_im), A = A0 + dmu A_mu0;
+    // its preconditioner: the complex BILU solve in the same form
+    const internal::real_split_shifted_operator<std::decay_t<decltype(a)>, std::decay_t<decltype(amu)>> inner(
+        a, om, n, &amu, dmu);
+    const internal::complex_preconditioner_split_form<std::decay_t<decltype(ilu)>> inner_pre(ilu, n, padded);
     Eigen::MatrixXd u(2 * n, 2), vt = Eigen::MatrixXd::Zero(2, 2 * n);
     u.col(0) << amu * pr, amu * pi;
     u.col(1) << pi, -pr;

@@ -410,25 +410,8 @@ symmetric_hopf_curve_result trace_symmetric_hopf_curve(const F& family, double n
     const vec<double> gr = (jacobian_product(sp, wp, mu, pr) - jacobian_product(sm, wm, mu, pr)) / (2 * h);
     const vec<double> gi = (jacobian_product(sp, wp, mu, pi) - jacobian_product(sm, wm, mu, pi)) / (2 * h);
     cilu.compute(shifted(lb, C(0.0, om)));
-    vec<double> xin = vec<double>::Zero(padded), xout(padded);
-    auto inner = [&](const vec<double>& v, vec<double>& r) {
-      xin.head(n) = v.head(n);
-      a.multiply(xin, xout);
-      r.head(n) = xout.head(n);
-      xin.head(n) = v.tail(n);
-      a.multiply(xin, xout);
-      r.tail(n) = xout.head(n);
-      r.head(n) += om * v.tail(n);
-      r.tail(n) -= om * v.head(n);
-    };
-    vec<C> rc = vec<C>::Zero(padded), zc(padded);
-    auto inner_pre = [&](const vec<double>& r, vec<double>& z) {
-      rc.head(n).real() = r.head(n);
-      rc.head(n).imag() = r.tail(n);
-      cilu.apply(rc, zc);
-      z.head(n) = zc.head(n).real();
-      z.tail(n) = zc.head(n).imag();
-    };
+    const internal::real_split_shifted_operator<std::decay_t<decltype(a)>> inner(a, om, n);
+    const internal::complex_preconditioner_split_form<std::decay_t<decltype(cilu)>> inner_pre(cilu, n, padded);
     Eigen::MatrixXd u(2 * n, 3), vt = Eigen::MatrixXd::Zero(3, 2 * n), d = Eigen::MatrixXd::Zero(3, 3);
     u.col(0) << amu * pr, amu * pi;
     u.col(1) << gr, gi;

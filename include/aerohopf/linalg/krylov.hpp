@@ -120,8 +120,8 @@ struct krylov_state {
 
 }  // namespace internal
 
-/// Right-preconditioned restarted GMRES(m) (Arnoldi with modified Gram-Schmidt, complex Givens
-/// rotations). The solution update M^{-1}(V y) is formed once per cycle, so no preconditioned
+/// Right-preconditioned restarted GMRES(m) (Arnoldi with classical Gram-Schmidt applied twice,
+/// complex Givens rotations). The solution update M^{-1}(V y) is formed once per cycle, so no preconditioned
 /// basis is stored (n (m+1) scalars of memory).
 template <class S, class Op, class Pre>
 krylov_report gmres(const Op& a, const Pre& m_pre, const vec<S>& b, vec<S>& x, const krylov_options& opt = {}) {
@@ -134,7 +134,7 @@ krylov_report gmres(const Op& a, const Pre& m_pre, const vec<S>& b, vec<S>& x, c
   st.rep.initial_residual = beta / st.scale();
   st.record(beta);
   Eigen::Matrix<S, Eigen::Dynamic, Eigen::Dynamic> v(n, m + 1), h = Eigen::Matrix<S, Eigen::Dynamic, Eigen::Dynamic>::Zero(m + 1, m);
-  vec<S> g(m + 1), sn(m);
+  vec<S> g(m + 1), sn(m), hc(m + 1), hc2(m + 1);
   Eigen::Matrix<real, Eigen::Dynamic, 1> cs(m);
   std::string reason;
   while (true) {
@@ -152,9 +152,16 @@ krylov_report gmres(const Op& a, const Pre& m_pre, const vec<S>& b, vec<S>& x, c
       z = v.col(j);
       st.pre(z, r);  // r used as scratch: M^{-1} v_j
       st.op(r, w);
-      for (int i = 0; i <= j; ++i) {
-        h(i, j) = v.col(i).dot(w);
-        w -= h(i, j) * v.col(i);
+      {  // classical Gram-Schmidt applied twice (CGS2): as stable as modified Gram-Schmidt
+         // and two matrix-vector passes over the basis instead of j+1 dot/axpy pairs
+        const auto vj = v.leftCols(j + 1);
+        auto hj = hc.head(j + 1);
+        hj.noalias() = vj.adjoint() * w;
+        w.noalias() -= vj * hj;
+        auto h2 = hc2.head(j + 1);
+        h2.noalias() = vj.adjoint() * w;
+        w.noalias() -= vj * h2;
+        h.col(j).head(j + 1) = hj + h2;
       }
       const real hn = w.norm();
       for (int i = 0; i < j; ++i) {  // previous rotations
