@@ -74,7 +74,48 @@ struct row_accumulator {
 
 template <int B>
 struct row_accumulator<std::complex<double>, B> {
-#if defined(__SSE2__)
+#if defined(AEROHOPF_AVX2_BLOCK_KERNELS)
+  // P = sum A x_re, Q = sum A x_im on the interleaved (re, im) lanes, two block rows per 256-bit
+  // register (one 128-bit register for an odd last row); A x = P + i Q, i.e.
+  // (P_re - Q_im, P_im + Q_re) = addsub(P, swap(Q)), formed once per block row in finish().
+  static constexpr int nv = B / 2;
+  static constexpr bool odd = B % 2 != 0;
+  __m256d p[nv > 0 ? nv : 1], q[nv > 0 ? nv : 1];
+  __m128d p1 = _mm_setzero_pd(), q1 = _mm_setzero_pd();
+  row_accumulator() {
+    for (int v = 0; v < nv; ++v) p[v] = q[v] = _mm256_setzero_pd();
+  }
+  inline void add(const std::complex<double>* __restrict ac, const std::complex<double>* __restrict xc) {
+    const double* a = reinterpret_cast<const double*>(ac);
+    const double* x = reinterpret_cast<const double*>(xc);
+    for (int c = 0; c < B; ++c) {
+      const __m256d xr = _mm256_broadcast_sd(x + 2 * c), xi = _mm256_broadcast_sd(x + 2 * c + 1);
+      const double* col = a + 2 * B * c;
+      for (int v = 0; v < nv; ++v) {
+        const __m256d av = _mm256_loadu_pd(col + 4 * v);
+        p[v] = _mm256_fmadd_pd(av, xr, p[v]);
+        q[v] = _mm256_fmadd_pd(av, xi, q[v]);
+      }
+      if constexpr (odd) {
+        const __m128d av = _mm_loadu_pd(col + 4 * nv);
+        p1 = _mm_fmadd_pd(av, _mm256_castpd256_pd128(xr), p1);
+        q1 = _mm_fmadd_pd(av, _mm256_castpd256_pd128(xi), q1);
+      }
+    }
+  }
+  template <int Sign>
+  inline void finish(std::complex<double>* __restrict accc) const {
+    double* acc = reinterpret_cast<double*>(accc);
+    for (int v = 0; v < nv; ++v) {
+      const __m256d r = _mm256_addsub_pd(p[v], _mm256_permute_pd(q[v], 0x5)), o = _mm256_loadu_pd(acc + 4 * v);
+      _mm256_storeu_pd(acc + 4 * v, Sign > 0 ? _mm256_add_pd(o, r) : _mm256_sub_pd(o, r));
+    }
+    if constexpr (odd) {
+      const __m128d r = _mm_addsub_pd(p1, _mm_permute_pd(q1, 0x1)), o = _mm_loadu_pd(acc + 4 * nv);
+      _mm_storeu_pd(acc + 4 * nv, Sign > 0 ? _mm_add_pd(o, r) : _mm_sub_pd(o, r));
+    }
+  }
+#elif defined(__SSE2__)
   // one (re, im) register per block row: t += (ar, ai) * xr + (ai, ar) * (-xi, xi)
   __m128d t[B];
   row_accumulator() {
@@ -172,66 +213,6 @@ struct row_accumulator<double, 5> {
   }
 };
 
-// ---- complex: P = sum A x_re, Q = sum A x_im (interleaved re/im lanes); A x = P + i Q, i.e.
-// (P_re - Q_im, P_im + Q_re) = addsub(P, swap(Q)) once per row.
-inline __m256d avx2_complex_combine(__m256d p, __m256d q) { return _mm256_addsub_pd(p, _mm256_permute_pd(q, 0x5)); }
-
-template <>
-struct row_accumulator<std::complex<double>, 4> {
-  __m256d p0 = _mm256_setzero_pd(), p1 = _mm256_setzero_pd(), q0 = _mm256_setzero_pd(), q1 = _mm256_setzero_pd();
-  inline void add(const std::complex<double>* __restrict ac, const std::complex<double>* __restrict xc) {
-    const double* a = reinterpret_cast<const double*>(ac);
-    const double* x = reinterpret_cast<const double*>(xc);
-    for (int c = 0; c < 4; ++c) {
-      const __m256d xr = _mm256_broadcast_sd(x + 2 * c), xi = _mm256_broadcast_sd(x + 2 * c + 1);
-      const __m256d a0 = _mm256_loadu_pd(a + 8 * c), a1 = _mm256_loadu_pd(a + 8 * c + 4);
-      p0 = _mm256_fmadd_pd(a0, xr, p0);
-      p1 = _mm256_fmadd_pd(a1, xr, p1);
-      q0 = _mm256_fmadd_pd(a0, xi, q0);
-      q1 = _mm256_fmadd_pd(a1, xi, q1);
-    }
-  }
-  template <int Sign>
-  inline void finish(std::complex<double>* __restrict accc) const {
-    double* acc = reinterpret_cast<double*>(accc);
-    const __m256d r0 = avx2_complex_combine(p0, q0), r1 = avx2_complex_combine(p1, q1);
-    const __m256d o0 = _mm256_loadu_pd(acc), o1 = _mm256_loadu_pd(acc + 4);
-    _mm256_storeu_pd(acc, Sign > 0 ? _mm256_add_pd(o0, r0) : _mm256_sub_pd(o0, r0));
-    _mm256_storeu_pd(acc + 4, Sign > 0 ? _mm256_add_pd(o1, r1) : _mm256_sub_pd(o1, r1));
-  }
-};
-
-template <>
-struct row_accumulator<std::complex<double>, 5> {
-  __m256d p0 = _mm256_setzero_pd(), p1 = _mm256_setzero_pd(), q0 = _mm256_setzero_pd(), q1 = _mm256_setzero_pd();
-  __m128d p2 = _mm_setzero_pd(), q2 = _mm_setzero_pd();
-  inline void add(const std::complex<double>* __restrict ac, const std::complex<double>* __restrict xc) {
-    const double* a = reinterpret_cast<const double*>(ac);
-    const double* x = reinterpret_cast<const double*>(xc);
-    for (int c = 0; c < 5; ++c) {
-      const __m256d xr = _mm256_broadcast_sd(x + 2 * c), xi = _mm256_broadcast_sd(x + 2 * c + 1);
-      const __m256d a0 = _mm256_loadu_pd(a + 10 * c), a1 = _mm256_loadu_pd(a + 10 * c + 4);
-      const __m128d a2 = _mm_loadu_pd(a + 10 * c + 8);
-      p0 = _mm256_fmadd_pd(a0, xr, p0);
-      p1 = _mm256_fmadd_pd(a1, xr, p1);
-      p2 = _mm_fmadd_pd(a2, _mm256_castpd256_pd128(xr), p2);
-      q0 = _mm256_fmadd_pd(a0, xi, q0);
-      q1 = _mm256_fmadd_pd(a1, xi, q1);
-      q2 = _mm_fmadd_pd(a2, _mm256_castpd256_pd128(xi), q2);
-    }
-  }
-  template <int Sign>
-  inline void finish(std::complex<double>* __restrict accc) const {
-    double* acc = reinterpret_cast<double*>(accc);
-    const __m256d r0 = avx2_complex_combine(p0, q0), r1 = avx2_complex_combine(p1, q1);
-    const __m128d r2 = _mm_addsub_pd(p2, _mm_permute_pd(q2, 0x1));
-    const __m256d o0 = _mm256_loadu_pd(acc), o1 = _mm256_loadu_pd(acc + 4);
-    const __m128d o2 = _mm_loadu_pd(acc + 8);
-    _mm256_storeu_pd(acc, Sign > 0 ? _mm256_add_pd(o0, r0) : _mm256_sub_pd(o0, r0));
-    _mm256_storeu_pd(acc + 4, Sign > 0 ? _mm256_add_pd(o1, r1) : _mm256_sub_pd(o1, r1));
-    _mm_storeu_pd(acc + 8, Sign > 0 ? _mm_add_pd(o2, r2) : _mm_sub_pd(o2, r2));
-  }
-};
 #endif  // AEROHOPF_AVX2_BLOCK_KERNELS
 
 /// Software prefetch of the bytes [p + distance, p + distance + bytes) of a read-only stream,
