@@ -13,6 +13,7 @@
 #include <aerohopf/models/aerofoil.hpp>
 
 #include <complex>
+#include <cstdlib>
 #include <iostream>
 
 using namespace aerohopf;
@@ -119,6 +120,57 @@ TEST(hopf_bordered, grid_sequencing_start_from_the_coarser_grid) {
   EXPECT_NEAR(r.point.mu, reference().point.mu, 0.05);  // grid convergence: close, not equal
   EXPECT_NEAR(r.point.omega, reference().point.omega, 0.02);
   EXPECT_LE(r.report.iterations, 6);
+}
+
+// The start refinement (hopf_krylov_options::start_iterations): a continuation-like guess whose
+// eigenvector carries a large wrong component (half its norm, spread over the flow unknowns as
+// when shocks move) and whose Ubar, omega are off by 2 %: one inverse iteration must lower the
+// Hopf residual at the guess by more than 10x, be kept, and Newton must land on the same point
+// as the reference in no more iterations than from the raw guess. An exact guess must not be
+// spoilt: the refinement raises ||F|| there, so it is discarded.
+TEST(hopf_bordered, start_refinement_recovers_a_poor_eigenvector_guess) {
+  const auto& f = fix();
+  const hopf_point& ref = reference().point;
+  hopf_point g = ref;
+  g.mu *= 1.02;
+  g.omega *= 0.98;
+  std::srand(7);
+  vec<cplx> noise = vec<cplx>::Random(ref.p.size());
+  noise.tail(aerofoil_system::n_structure).setZero();
+  g.p += (0.5 * ref.p.norm() / noise.norm()) * noise;
+  hopf_krylov_options raw;
+  raw.fill_level = 1;
+  hopf_options verbose = f.opt;
+  verbose.verbose = true;
+  verbose.label = "raw guess";
+  const hopf_result r0 = solve_hopf_krylov<4>(f.s, g, verbose, raw);
+  hopf_krylov_options refined = raw;
+  refined.start_iterations = 1;
+  verbose.label = "refined guess";
+  const hopf_result r1 = solve_hopf_krylov<4>(f.s, g, verbose, refined);
+  std::cout << "Newton iterations from the perturbed guess: raw " << r0.report.iterations << ", refined "
+            << r1.report.iterations << " (|F| at the start " << r0.report.residual_history.front() << " -> "
+            << r1.report.residual_history.front() << ")\n";
+  EXPECT_TRUE(r1.start_refined);
+  EXPECT_FALSE(r0.start_refined);
+  EXPECT_LT(r1.report.residual_history.front(), 0.1 * r0.report.residual_history.front());
+  EXPECT_LE(r1.report.iterations, r0.report.iterations);
+  EXPECT_NEAR(r1.point.mu, ref.mu, 1e-9);
+  EXPECT_NEAR(r1.point.omega, ref.omega, 1e-9);
+  EXPECT_LT(eigen_residual(f.s, r1.point), 1e-9);
+  EXPECT_GT(r1.linear_iterations, r1.report.iterations);  // the start's GMRES iterations are counted
+
+  hopf_krylov_options above = refined;  // a guess below the threshold is not refined
+  above.start_residual_threshold = 2 * r0.report.residual_history.front();
+  EXPECT_FALSE(solve_hopf_krylov<4>(f.s, g, f.opt, above).start_refined);
+
+  verbose.label = "exact guess";
+  const hopf_result r2 = solve_hopf_krylov<4>(f.s, ref, verbose, refined);
+  EXPECT_FALSE(r2.start_refined);
+  // the singular start solve is capped (hopf_krylov_options::start_max_iterations)
+  EXPECT_LE(r2.linear_iterations, refined.start_max_iterations + 100);
+  EXPECT_NEAR(r2.point.mu, ref.mu, 1e-9);
+  EXPECT_LE(r2.report.iterations, 1);
 }
 
 TEST(hopf_bordered, refuses_bad_input) {

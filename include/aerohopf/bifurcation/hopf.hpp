@@ -67,6 +67,7 @@ struct hopf_result {
   /// Wall-clock split (solve_hopf_krylov only; 0 elsewhere): matrix assembly and preconditioner
   /// factorisation, Krylov solves, and residual evaluations.
   double setup_seconds = 0, linear_seconds = 0, residual_seconds = 0;
+  bool start_refined = false;  ///< solve_hopf_krylov: the start refinement was kept
 };
 
 /// Rotates the phase of p and scales it so that s.p_r = 0 and s.p_i = 1 for the returned s
