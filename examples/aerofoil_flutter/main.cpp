@@ -249,14 +249,16 @@ boundary natural_boundary(const structural_case& c, const grid_level& g, const s
                           const boundary* coarser, int coarser_ratio, int fill, csv_writer& csv) {
   boundary b;
   std::size_t branch_start = 0;  // first point of the current branch (a jump starts a new one)
-  auto write = [&](const boundary_point& p) {
-    const double cosine = b.size() > branch_start ? structural_cosine(b.back().point.p, p.point.p) : 1.0;
+  // cosine: structural_cosine to the previous point (NAN for the first point of the boundary;
+  // at a jump, to the last point of the ended branch)
+  auto write = [&](const boundary_point& p, double cosine) {
     b.push_back(p);
     csv.row({p.mach, p.ubar, p.omega, static_cast<long long>(p.newton_iterations),
              static_cast<long long>(p.linear_iterations), p.hopf_seconds, p.steady_seconds});
-    std::printf("  %-6s %-8s M = %.4f  Ubar* = %.6f  omega* = %.6f  Newton %d  GMRES %5ld  hopf %.2f s  steady %.2f s  (ratio %.2f)  mode cosine %.3f\n",
+    std::printf("  %-6s %-8s M = %.4f  Ubar* = %.6f  omega* = %.6f  Newton %d  GMRES %5ld  hopf %.2f s  steady %.2f s  (ratio %.2f)  mode cosine %s\n",
                 c.name.c_str(), g.name.c_str(), p.mach, p.ubar, p.omega, p.newton_iterations, p.linear_iterations,
-                p.hopf_seconds, p.steady_seconds, p.hopf_seconds / p.steady_seconds, cosine);
+                p.hopf_seconds, p.steady_seconds, p.hopf_seconds / p.steady_seconds,
+                std::isfinite(cosine) ? fixed(cosine, 3).c_str() : "-");
     std::fflush(stdout);
   };
   for (double mach : machs) {
@@ -264,6 +266,7 @@ boundary natural_boundary(const structural_case& c, const grid_level& g, const s
     const double full_step = mach - m_done;
     double step = full_step;
     std::optional<boundary_point> other_mode;  // the other mode's point found at the smallest step
+    double other_cosine = NAN;                 // ... and its structural cosine to b.back()
     while (b.empty() || b.back().mach < mach - 1e-9) {
       const double m = b.empty() ? mach : std::min(mach, b.back().mach + step);
       const auto s = make_system(g, m, c.mu_s);
@@ -300,20 +303,21 @@ boundary natural_boundary(const structural_case& c, const grid_level& g, const s
       }
       const double start_seconds = seconds_since(t0);
       auto p = hopf_at(s, m, st, guess, fill, label);
-      if (p && b.size() > branch_start) {
-        const double cosine = structural_cosine(b.back().point.p, p->point.p);
-        if (cosine < same_mode_cosine) {
-          std::printf("    %s: Hopf point Ubar* = %.4f, omega* = %.4f belongs to another mode (structural cosine %.3f "
-                      "to the point at M = %.4f)\n",
-                      label.c_str(), p->ubar, p->omega, cosine, b.back().mach);
-          p->hopf_seconds += start_seconds;
-          other_mode = std::move(p);
-          p.reset();
-        }
-      }
+      double cosine = NAN;
       if (p) {
         p->hopf_seconds += start_seconds;
-        write(*p);
+        if (!b.empty()) cosine = structural_cosine(b.back().point.p, p->point.p);
+      }
+      if (p && b.size() > branch_start && cosine < same_mode_cosine) {
+        std::printf("    %s: Hopf point Ubar* = %.4f, omega* = %.4f belongs to another mode (structural cosine %.3f "
+                    "to the point at M = %.4f)\n",
+                    label.c_str(), p->ubar, p->omega, cosine, b.back().mach);
+        other_mode = std::move(p);
+        other_cosine = cosine;
+        p.reset();
+      }
+      if (p) {
+        write(*p, cosine);
         other_mode.reset();
         step = std::min(2.0 * step, full_step);
         continue;
@@ -327,7 +331,7 @@ boundary natural_boundary(const structural_case& c, const grid_level& g, const s
                       "within 1/8 of the Mach step); the boundary jumps to the other mode's Hopf point found there\n",
                       label.c_str(), b.back().mach, other_mode->mach);
           branch_start = b.size();
-          write(*other_mode);
+          write(*other_mode, other_cosine);
           other_mode.reset();
           continue;
         }

@@ -343,7 +343,7 @@ hopf_result solve_hopf_krylov(const S& sys, const hopf_point& guess, const hopf_
     ilu.compute(shifted(lb, C(0.0, om)));
     setup_seconds += since(t0);
   };
-  if (kopt.reuse_matrices || kopt.start_iterations > 0) refresh(x[N - 2], x[N - 1]);
+  if (kopt.reuse_matrices) refresh(x[N - 2], x[N - 1]);
   long start_linear_iterations = 0;
   bool start_refined = false;
   double f_guess = 0.0;
@@ -354,6 +354,7 @@ hopf_result solve_hopf_krylov(const S& sys, const hopf_point& guess, const hopf_
   }
   if (kopt.start_iterations > 0 && f_guess > kopt.start_residual_threshold) {
     // inverse iteration with the shift i omega of the guess (see hopf_krylov_options)
+    if (!kopt.reuse_matrices) refresh(x[N - 2], x[N - 1]);  // otherwise assembled above
     const auto t0 = clock::now();
     const double om = x[N - 1];
     const internal::real_split_shifted_operator<std::decay_t<decltype(a)>> shifted_a(a, om, n);
