@@ -98,30 +98,11 @@ int main(int argc, char** argv) {
     guess.mu = c.ubar_guess;
 
     auto family = [&](double mach) { return make_system(g, mach, c.mu_s); };
-    hopf_curve_options ho;
-    ho.mu_scale = o.mu_scale;
-    ho.nu_scale = o.nu_scale;
-    ho.omega_scale = o.omega_scale;
-    ho.max_step = o.max_step;
-    ho.step = std::min(0.5, o.max_step);
-    ho.min_step = 1e-3;
-    ho.nu_min = m0 - 1e-9;
-    ho.nu_max = o.mach_max;
-    ho.mu_min = 0.2;
-    ho.mu_max = 20.0;
+    tracer_options to = aerofoil_tracer_options(g, c, m0, o.mach_max, o.fill, o.mu_scale, o.nu_scale, o.omega_scale,
+                                                o.max_step);
+    hopf_curve_options& ho = to.curve;
     ho.max_points = o.max_points;
-    ho.fast_iterations = 4;
-    ho.newton.max_iterations = 8;  // 3-5 quadratic steps when it converges; fail fast at kinks
-    for (int k = static_cast<int>(std::ceil(m0 * 100 + 1e-6)); k <= static_cast<int>(std::floor(o.mach_max * 100 + 1e-6)); ++k)
-      ho.nu_targets.push_back(k / 100.0);
-    ho.throw_on_failure = false;
-    ho.label = c.name + " " + g.name;
-    ho.verbose = true;
-    ho.start.newton.max_iterations = 20;
-    symmetric_hopf_curve_options so;
-    so.fill_level = o.fill;
-    // third start of the nested steady Newton: the pseudo-transient solve from the free stream
-    so.equilibrium_start = [&](double mach) { return make_system(g, mach, c.mu_s).steady_equilibrium(); };
+    symmetric_hopf_curve_options& so = to.symmetric;
     csv_writer csv(o.out / ("hopf_curve_sym_" + c.name + "_" + g.name + ".csv"),
                    "mach,ubar,omega,newton_iterations,linear_iterations,step,seconds,landed");
     so.observer = [&](const hopf_curve_point& p, const symmetric_hopf_curve_stats& s) {

@@ -14,7 +14,7 @@
 //   --hopf-tol t                Newton tolerance ||F|| of the boundary points (default 1e-7)
 //   --start-iterations k        inverse iterations on the continued eigenvector before each
 //                               boundary point's Newton iteration (default 1; 0 = none)
-//   --skip-spectra --skip-boundaries --skip-verify --skip-reduced    parts to leave out
+//   --skip-spectra --skip-boundaries --skip-jump-check --skip-verify --skip-reduced   parts to leave out
 //   --verify-grid g             grid of the time-marching verification (default medium)
 //   --contact-smoothing d       contact-switch smoothing of the reduced-model part (default 0.05;
 //                               0 = exact Osher switch, whose residual is not C2 at the equilibrium)
@@ -23,6 +23,7 @@
 //
 // Outputs under out_dir (default out/aerofoil_flutter):
 //   flutter_point_very_coarse.txt, spectra.csv (ubar,re,im)     very coarse, light, M = 0.5
+//   boundary_<case>_very_coarse.csv, jump_check.csv             boundary jumps checked by dense spectra
 //   boundary_<case>_<grid>.csv  mach,ubar,omega,newton_iterations,linear_iterations,hopf_seconds,steady_seconds
 //   verification.csv, history_<case>_M<mach>_<factor>.csv       time marching at 0.97 / 1.03 Ubar*
 //   costs.csv                                                   cost ratios to the steady solve
@@ -32,6 +33,7 @@
 #include <aerohopf/bifurcation/hopf.hpp>
 #include <aerohopf/bifurcation/hopf_bordered.hpp>
 #include <aerohopf/bifurcation/hopf_curve.hpp>
+#include <aerohopf/bifurcation/hopf_curve_symmetric.hpp>
 #include <aerohopf/bifurcation/inverse_power.hpp>
 #include <aerohopf/flow/naca_cgrid.hpp>
 #include <aerohopf/flow/steady_solver.hpp>
@@ -77,7 +79,7 @@ struct options {
   std::string method = "natural";
   int fill = 1;
   double contact_smoothing = 0.05;  // of the reduced model's discretisation (osher_flux.hpp)
-  bool spectra = true, boundaries = true, verify = true, reduced = true, quick = false;
+  bool spectra = true, boundaries = true, jump_check = true, verify = true, reduced = true, quick = false;
   grid_level verify_grid = level_named("medium");
 };
 
@@ -235,6 +237,65 @@ double structural_cosine(const vec<cplx>& p0, const vec<cplx>& p1) {
 }
 constexpr double same_mode_cosine = 0.9;
 
+/// Hand-over of natural continuation to pseudo-arclength continuation where natural continuation
+/// stops: a steep stretch of the boundary, where the Hopf point moves so fast with M that no
+/// Mach step of the secant predictor lands in Newton's basin (heavy case, coarse grid: at
+/// M = 0.826-0.828 Ubar* peaks at ~6.1 while omega* moves from 0.20 to 0.41). The symmetric
+/// Hopf-curve tracer (trace_symmetric_hopf_curve, options of aerofoil_tracer_options) starts
+/// from the last boundary point `from` and follows the curve in (M, Ubar, omega) up to the first
+/// listed Mach number above from.mach that it lands on exactly, and stops there, or earlier if
+/// the curve turns back in M by more than 0.005 (the boundary is then not this curve: natural
+/// continuation finds the other mode) or the tracer fails (dense kinks). Returns its accepted points with
+/// M > from.mach, in M order; natural continuation resumes from the last one. Their
+/// steady_seconds is from.steady_seconds (the unit of cost: no extra steady solves are run).
+boundary arclength_bridge(const structural_case& c, const grid_level& g, const std::vector<double>& machs,
+                          const boundary_point& from, int fill) {
+  const double m_max = machs.back();
+  tracer_options to = aerofoil_tracer_options(g, c, from.mach, m_max, fill);
+  hopf_curve_options& ho = to.curve;
+  ho.nu_targets.clear();
+  for (double m : machs)
+    if (m > from.mach + 1e-9) ho.nu_targets.push_back(m);
+  ho.max_points = 200;
+  ho.label = c.name + " " + g.name + " arclength";
+  ho.verbose = true;  // a line per curve point (progress: the medium-grid points take 5-60 s)
+  ho.start.newton.abs_tolerance = boundary_tolerance;
+  ho.newton.abs_tolerance = boundary_tolerance;
+  double m_hi = from.mach;
+  const double fold_tolerance = 0.005;
+  boundary out;
+  to.symmetric.observer = [&](const hopf_curve_point& p, const symmetric_hopf_curve_stats& st) {
+    if (p.nu <= m_hi + 1e-9) return;  // the start, or a point back in M
+    m_hi = p.nu;
+    hopf_point q = p.point();
+    q.mu = std::abs(q.mu);  // Ubar enters only through 1/Ubar^2 (spec 05)
+    out.push_back({p.nu, q.mu, p.omega, p.newton_iterations, st.linear_iterations, p.seconds, from.steady_seconds,
+                   std::move(q)});
+  };
+  // a fold in M smaller than half a listed step (medium grid: the curve turns back by ~1e-4 in M at
+  // the Ubar* peak near M = 0.826 and forward again) is traced through; the points on its way
+  // back are not boundary points (the observer skips them: the boundary jumps to the branch below)
+  ho.stop_after = [&](const hopf_curve_point& p) {
+    return (p.landed && p.nu > from.mach + 1e-9) || p.nu < m_hi - fold_tolerance;
+  };
+  auto family = [&](double mach) { return make_system(g, mach, c.mu_s); };
+  std::printf("    hand-over to pseudo-arclength continuation of the Hopf curve from M = %.5f (Ubar* = %.5f, omega* = "
+              "%.5f) up to the next listed Mach number\n",
+              from.mach, from.ubar, from.omega);
+  symmetric_hopf_curve_result r;
+  try {
+    r = trace_symmetric_hopf_curve<4>(family, from.mach, from.point, ho, +1, to.symmetric);
+  } catch (const error& e) {  // e.g. the start's nested steady solve: keep what was traced
+    std::printf("    arclength failed: %s\n", e.what());
+    return out;
+  }
+  std::printf("    arclength: %zu points (%zu beyond M = %.5f), %d failed correctors, %d steps at fixed M or Ubar, "
+              "%d nested steady solves, %.2f s; stop: %s\n",
+              r.points.size(), out.size(), from.mach, r.failed_correctors, r.kink_steps, r.steady_solves, r.seconds,
+              r.stop_reason.c_str());
+  return out;
+}
+
 /// Natural continuation in M: each point starts from the previous one (Ubar, omega and the
 /// eigenvector by secant extrapolation over the last two points of the branch, the eigenvector
 /// then refined by one inverse iteration: hopf_krylov_options::start_iterations). A point is
@@ -268,7 +329,8 @@ boundary natural_boundary(const structural_case& c, const grid_level& g, const s
     std::optional<boundary_point> other_mode;  // the other mode's point found at the smallest step
     double other_cosine = NAN;                 // ... and its structural cosine to b.back()
     while (b.empty() || b.back().mach < mach - 1e-9) {
-      const double m = b.empty() ? mach : std::min(mach, b.back().mach + step);
+      if (!b.empty()) step = std::min(step, mach - b.back().mach);  // halve the step actually tried
+      const double m = b.empty() || step >= mach - b.back().mach ? mach : b.back().mach + step;
       const auto s = make_system(g, m, c.mu_s);
       const auto st = steady(s);
       hopf_point guess;
@@ -336,9 +398,19 @@ boundary natural_boundary(const structural_case& c, const grid_level& g, const s
           continue;
         }
         std::cout << "    " << label << ": no convergence from M = " << b.back().mach
-                  << " even with 1/8 of the Mach step: the boundary is not continued past M = " << b.back().mach
-                  << " by natural continuation\n";
-        return b;
+                  << " even with 1/8 of the Mach step\n";
+        const double m_before = b.back().mach;
+        for (auto& q : arclength_bridge(c, g, machs, b.back(), fill)) {
+          const double cosine = structural_cosine(b.back().point.p, q.point.p);
+          write(q, cosine);
+        }
+        if (b.back().mach <= m_before + 1e-9) {
+          std::printf("    the boundary is not continued past M = %.5f (natural and arclength continuation failed)\n",
+                      m_before);
+          return b;
+        }
+        step = full_step;  // natural continuation resumes from the last point of the arclength stretch
+        continue;
       }
       step *= 0.5;
       std::cout << "    retrying with Mach step " << step << "\n";
@@ -431,6 +503,70 @@ std::map<std::string, boundary> boundaries_part(const options& o) {
   return all;
 }
 
+
+// ---------------------------------------------------------------------------------------------
+// Part 2b: where a boundary jumps to another mode, is the new point the LOWEST flutter speed?
+// Natural continuation only knows the mode it follows; after its branch ends (or the tracer
+// passes a fold) it accepts the other mode's Hopf point it finds. On the very coarse grid (256
+// cells, 1028 unknowns: a dense eigen-decomposition takes ~2 s) the whole spectrum decides: at
+// the Mach number of every jump, and at the last one, the largest real part over ALL eigenvalues
+// of the coupled Jacobian is scanned over Ubar = 0.2 .. 0.98 Ubar* (14 values) and at
+// 0.995 / 1.005 Ubar*. The point is the lowest crossing (within the scan) iff max Re < 0 below
+// it and > 0 just above it. Writes jump_check.csv (case,mach,ubar_star,ubar,max_re,im_at_max).
+
+void jump_check_part(const options& o) {
+  const grid_level g = level_named("very_coarse");
+  const auto machs = mach_list(o);
+  csv_writer out(o.out / "jump_check.csv", "case,mach,ubar_star,ubar,max_re,im_at_max");
+  int checked = 0, failed = 0;
+  for (const auto& c : o.cases) {
+    std::cout << "\n=== jump check: " << c.name << " case, very coarse grid (dense spectra over Ubar) ===\n";
+    csv_writer bcsv(o.out / ("boundary_" + c.name + "_" + g.name + ".csv"),
+                    "mach,ubar,omega,newton_iterations,linear_iterations,hopf_seconds,steady_seconds");
+    const boundary b = natural_boundary(c, g, machs, nullptr, 0, o.fill, bcsv);
+    std::vector<std::pair<std::size_t, const char*>> at;  // jumps (structural cosine < 0.9) and the last point
+    for (std::size_t k = 1; k < b.size(); ++k)
+      if (structural_cosine(b[k - 1].point.p, b[k].point.p) < same_mode_cosine) at.emplace_back(k, "jump");
+    if (!b.empty() && (at.empty() || at.back().first != b.size() - 1)) at.emplace_back(b.size() - 1, "last point");
+    for (const auto& [k, what] : at) {
+      const auto& p = b[k];
+      const auto s = make_system(g, p.mach, c.mu_s);
+      const auto st = steady(s);
+      std::vector<double> factors;
+      for (int j = 0; j < 14; ++j) factors.push_back(0.2 + 0.06 * j);  // 0.20 .. 0.98
+      factors.push_back(0.995);
+      factors.push_back(1.005);
+      bool ok = true;
+      double worst_below = -1e300, lowest_unstable = NAN;
+      for (double f : factors) {
+        const double ubar = f * p.ubar;
+        Eigen::EigenSolver<Eigen::MatrixXd> es(Eigen::MatrixXd(s.jacobian(st.w, ubar)), false);
+        cplx top = es.eigenvalues()[0];
+        for (const auto& l : es.eigenvalues())
+          if (l.real() > top.real()) top = l;
+        out.row({c.name, p.mach, p.ubar, ubar, top.real(), std::abs(top.imag())});
+        if (f < 1) {
+          worst_below = std::max(worst_below, top.real());
+          if (top.real() > 0 && !std::isfinite(lowest_unstable)) lowest_unstable = ubar;
+          ok = ok && top.real() < 0;
+        } else {
+          ok = ok && top.real() > 0;
+          std::printf("    M = %.4f (%s): above Ubar* (1.005 Ubar*) max Re lambda = %+.3e at omega = %.4f (Hopf omega* %.4f)\n",
+                      p.mach, what, top.real(), std::abs(top.imag()), p.omega);
+        }
+      }
+      std::printf("    M = %.4f  Ubar* = %.5f: max Re lambda over 0.2 .. 0.995 Ubar* = %+.3e -> %s\n", p.mach, p.ubar,
+                  worst_below,
+                  ok ? "lowest crossing (PASS)"
+                     : (std::isfinite(lowest_unstable)
+                            ? ("unstable already at Ubar = " + fixed(lowest_unstable, 4) + " (FAIL)").c_str()
+                            : "no crossing at Ubar* (FAIL)"));
+      ++checked;
+      failed += ok ? 0 : 1;
+    }
+  }
+  std::printf("  jump check: %d points checked, %d failed\n", checked, failed);
+}
 
 // ---------------------------------------------------------------------------------------------
 // Part 3: time marching at 0.97 and 1.03 Ubar* (implicit BDF2, dual time, dt = 0.125).
@@ -769,6 +905,8 @@ int main(int argc, char** argv) {
         o.spectra = false;
       } else if (a == "--skip-boundaries") {
         o.boundaries = false;
+      } else if (a == "--skip-jump-check") {
+        o.jump_check = false;
       } else if (a == "--skip-verify") {
         o.verify = false;
       } else if (a == "--skip-reduced") {
@@ -790,6 +928,7 @@ int main(int argc, char** argv) {
       }
     }
     if (o.quick) {
+      o.jump_check = false;
       o.grids = {level_named("coarse")};
       o.verify_grid = level_named("coarse");
       o.mach_step = o.mach_step > 0 ? o.mach_step : 0.1;
@@ -800,6 +939,7 @@ int main(int argc, char** argv) {
     if (o.spectra) spectra_part(o);
     std::map<std::string, boundary> all;
     if (o.boundaries) all = boundaries_part(o);
+    if (o.jump_check) jump_check_part(o);
     std::vector<double> march_costs;
     if (o.verify) verification_part(o, all, march_costs);
     if (o.reduced) reduced_part(o, all);

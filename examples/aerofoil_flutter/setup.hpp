@@ -2,13 +2,16 @@
 // Shared set-up of the aerofoil flutter example programs (main.cpp, branch.cpp): the grid
 // levels (every stride-th point of the fine NACA 0012 C-grid), the two structural cases of
 // spec 05, the coupled system at a Mach number, and the timed steady solve from the free
-// stream (the unit of cost the examples report).
+// stream (the unit of cost the examples report), and the options of the symmetric Hopf-curve
+// tracer for this problem.
+#include <aerohopf/bifurcation/hopf_curve_symmetric.hpp>
 #include <aerohopf/error.hpp>
 #include <aerohopf/flow/naca_cgrid.hpp>
 #include <aerohopf/flow/steady_solver.hpp>
 #include <aerohopf/models/aerofoil.hpp>
 
 #include <chrono>
+#include <cmath>
 #include <iomanip>
 #include <sstream>
 #include <string>
@@ -84,6 +87,48 @@ inline steady_result steady(const aerofoil_system& s) {
   r.w = s.steady_equilibrium(so);
   r.seconds = seconds_since(t0);
   return r;
+}
+
+/// Options of trace_symmetric_hopf_curve (bifurcation/hopf_curve_symmetric.hpp) for the aerofoil,
+/// shared by aerofoil_branch and the hand-over of natural continuation in aerofoil_flutter.
+/// Metric: Ubar / mu_scale, M / nu_scale, omega / omega_scale (default 0.5, 0.01, 0.05: a step
+/// of 1 is at most 0.01 in M); steps 0.5 .. max_step, down to 1e-3; Ubar in [0.2, 20]; M in
+/// [m0, m_max] with every M = 0.01 k landed exactly; 8 Newton iterations per corrector (3-5
+/// quadratic steps when it converges: fail fast at kinks); BILU(fill); nested steady Newton to
+/// ||f|| <= 1e-10, its third start the pseudo-transient solve from the free stream.
+struct tracer_options {
+  aerohopf::hopf_curve_options curve;
+  aerohopf::symmetric_hopf_curve_options symmetric;
+};
+inline tracer_options aerofoil_tracer_options(const grid_level& g, const structural_case& c, double m0, double m_max,
+                                              int fill, double mu_scale = 0.5, double nu_scale = 0.01,
+                                              double omega_scale = 0.05, double max_step = 1.0) {
+  tracer_options t;
+  auto& ho = t.curve;
+  ho.mu_scale = mu_scale;
+  ho.nu_scale = nu_scale;
+  ho.omega_scale = omega_scale;
+  ho.max_step = max_step;
+  ho.step = std::min(0.5, max_step);
+  ho.min_step = 1e-3;
+  ho.nu_min = m0 - 1e-9;
+  ho.nu_max = m_max;
+  ho.mu_min = 0.2;
+  ho.mu_max = 20.0;
+  ho.fast_iterations = 4;
+  ho.newton.max_iterations = 8;
+  for (int k = static_cast<int>(std::ceil(m0 * 100 + 1e-6)); k <= static_cast<int>(std::floor(m_max * 100 + 1e-6)); ++k)
+    ho.nu_targets.push_back(k / 100.0);
+  ho.throw_on_failure = false;
+  ho.label = c.name + " " + g.name;
+  ho.verbose = true;
+  ho.start.newton.max_iterations = 20;
+  t.symmetric.fill_level = fill;
+  // nested steady Newton: ||f||_2 <= 1e-10 (the default 1e-11 is at the rounding floor of the
+  // medium grid: measured, Newton stalls at 1.6e-11 there); Hopf points are converged to 1e-7
+  t.symmetric.steady.abs_tolerance = 1e-10;
+  t.symmetric.equilibrium_start = [g, mu_s = c.mu_s](double mach) { return make_system(g, mach, mu_s).steady_equilibrium(); };
+  return t;
 }
 
 }  // namespace aerofoil_example

@@ -193,6 +193,38 @@ TEST(hopf_curve_symmetric, decreasing_direction_lands_on_the_lower_bound) {
   for (std::size_t k = 1; k < r.points.size(); ++k) EXPECT_LT(r.points[k].nu, r.points[k - 1].nu);
 }
 
+// stop_after ends the trace at the first accepted point it returns true for: here the first
+// point past the turning point nu = 1 of the circle (nu decreasing again), i.e. where a caller
+// that needs a boundary single-valued in nu hands over. Both tracers.
+TEST(hopf_curve_symmetric, stop_after_ends_the_trace_where_the_caller_asks) {
+  auto family = [](double nu) { return circle_family_system(nu); };
+  hopf_curve_options o = circle_options();
+  o.verbose = false;
+  double nu_hi = -9;
+  int calls = 0;
+  o.stop_after = [&](const hopf_curve_point& p) {
+    ++calls;
+    nu_hi = std::max(nu_hi, p.nu);
+    return p.nu < nu_hi - 1e-3;
+  };
+  const auto r = trace_symmetric_hopf_curve<2>(family, 0.6, circle_start(0.6, 0.78, 1.2), o, +1);
+  EXPECT_EQ(r.stop, hopf_curve_stop::requested);
+  ASSERT_GE(r.points.size(), 3u);
+  EXPECT_EQ(calls, static_cast<int>(r.points.size()));  // every accepted point, the stopping one last
+  EXPECT_GT(nu_hi, 0.99);
+  EXPECT_LT(r.points.back().nu, nu_hi - 1e-3);
+  EXPECT_LT(r.points.back().mu, 0);  // just past the turn (mu = 0 there)
+  for (std::size_t k = 0; k + 1 < r.points.size(); ++k) EXPECT_GE(r.points[k].mu, -0.2) << k;
+  // the full-system tracer honours it the same way
+  nu_hi = -9;
+  calls = 0;
+  const auto full = trace_hopf_curve(family, 0.6, circle_start(0.6, 0.78, 1.2), o, +1);
+  EXPECT_EQ(full.stop, hopf_curve_stop::requested);
+  EXPECT_EQ(calls, static_cast<int>(full.points.size()));
+  EXPECT_LT(full.points.back().nu, nu_hi - 1e-3);
+  EXPECT_LT(full.points.back().mu, 0);
+}
+
 // A kink of the curve at nu = 0.7 where it turns by ~117 degrees in the metric: the arclength
 // corrector cannot cross it at any step size; the fixed-nu fallback does.
 TEST(hopf_curve_symmetric, crosses_a_kink_at_fixed_nu) {

@@ -62,7 +62,8 @@
 // Stops: max_points; leaving [nu_min, nu_max] or [mu_min, mu_max] (the crossing is landed on
 // the bound exactly: Newton with the last row nu - bound = 0); omega <= omega_min or a sign
 // change of omega (Bogdanov-Takens: estimate of its (mu, nu) by extrapolating the last points
-// in omega^2, along which (mu, nu) are smooth); the curve closing on its start. nu_targets:
+// in omega^2, along which (mu, nu) are smooth); the curve closing on its start; stop_after
+// returning true for an accepted point (hopf_curve_stop::requested). nu_targets:
 // every crossing of a listed nu is landed exactly (a flutter boundary at given Mach numbers).
 #include <Eigen/Core>
 
@@ -110,7 +111,7 @@ struct hopf_curve_point {
   hopf_point point() const { return {w, mu, omega, p}; }
 };
 
-enum class hopf_curve_stop { max_points, nu_bounds, mu_bounds, bogdanov_takens, closed_curve, step_failure };
+enum class hopf_curve_stop { max_points, nu_bounds, mu_bounds, bogdanov_takens, closed_curve, step_failure, requested };
 
 struct hopf_curve_options {
   double step = 0.01;       ///< initial step in the scaled (mu, nu, omega) metric
@@ -139,6 +140,10 @@ struct hopf_curve_options {
   hopf_normalisation normalisation = hopf_normalisation::automatic;
   bool throw_on_failure = true;           ///< false: stop with step_failure instead of throwing
   std::function<void(const hopf_curve_point&)> observer;  ///< called for every accepted point
+  /// Called for every accepted point after the observer(s); true ends the trace there with
+  /// hopf_curve_stop::requested (e.g. a caller that needs the curve only up to the next landed
+  /// target, or only while nu increases).
+  std::function<bool(const hopf_curve_point&)> stop_after;
   bool verbose = false;
   std::ostream* log = &std::cout;
   std::string label = "hopf curve";
@@ -353,6 +358,7 @@ hopf_curve_result trace_hopf_curve(const F& family, double nu0, const hopf_point
     pt.landed = landed;
     return pt;
   };
+  bool stop_requested = false;  // opt.stop_after said so for the last accepted point
   auto emit = [&](hopf_curve_point pt) {
     if (opt.verbose && opt.log)
       *opt.log << lab << " " << std::setw(4) << res.points.size() << "  nu " << std::setprecision(10) << pt.nu
@@ -360,6 +366,7 @@ hopf_curve_result trace_hopf_curve(const F& family, double nu0, const hopf_point
                << std::setprecision(4) << pt.step << (pt.attempts > 1 ? "  (" + std::to_string(pt.attempts - 1) + " retries)" : "")
                << (pt.landed ? "  (landed)" : "") << std::setprecision(6) << "\n";
     if (opt.observer) opt.observer(pt);
+    stop_requested = opt.stop_after && opt.stop_after(pt);
     res.points.push_back(std::move(pt));
   };
   auto finish = [&](hopf_curve_stop why, std::string reason) {
@@ -404,6 +411,7 @@ hopf_curve_result trace_hopf_curve(const F& family, double nu0, const hopf_point
     if (t[inu] * direction < 0) t = -t;
   }
   if (res.points.size() >= size_t(opt.max_points)) return finish(hopf_curve_stop::max_points, "max_points reached");
+  if (stop_requested) return finish(hopf_curve_stop::requested, "stop requested by stop_after");
 
   // nu/mu values whose crossing is landed exactly: (row, value, is_bound)
   struct landing {
@@ -540,6 +548,7 @@ hopf_curve_result trace_hopf_curve(const F& family, double nu0, const hopf_point
                                        xl ? "" : " (landing failed: the last point lies outside)"));
       }
       if (res.points.size() >= size_t(opt.max_points)) return finish(hopf_curve_stop::max_points, "max_points reached");
+      if (stop_requested) return finish(hopf_curve_stop::requested, "stop requested by stop_after");
     }
 
     // ---- accept ----
@@ -547,6 +556,7 @@ hopf_curve_result trace_hopf_curve(const F& family, double nu0, const hopf_point
     arclength += len;
     emit(make_point(xnew, iters, attempts, len, seconds_since(t_point), false));
     if (res.points.size() >= size_t(opt.max_points)) return finish(hopf_curve_stop::max_points, "max_points reached");
+    if (stop_requested) return finish(hopf_curve_stop::requested, "stop requested by stop_after");
     s = refresh_s(xnew);
     x_prev = std::move(x);
     rescale_p(x_prev, s);

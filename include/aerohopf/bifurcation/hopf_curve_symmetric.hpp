@@ -476,6 +476,7 @@ symmetric_hopf_curve_result trace_symmetric_hopf_curve(const F& family, double n
     pt.landed = landed;
     return pt;
   };
+  bool stop_requested = false;  // opt.stop_after said so for the last accepted point
   auto emit = [&](hopf_curve_point pt) {
     if (opt.verbose && opt.log)
       *opt.log << lab << " " << std::setw(4) << res.points.size() << "  nu " << std::setprecision(10) << pt.nu
@@ -491,6 +492,7 @@ symmetric_hopf_curve_result trace_symmetric_hopf_curve(const F& family, double n
     res.steady_seconds += acc.steady_seconds;
     res.stats.push_back(acc);
     acc = {};
+    stop_requested = opt.stop_after && opt.stop_after(pt);
     res.points.push_back(std::move(pt));
   };
   auto finish = [&](hopf_curve_stop why, std::string reason) {
@@ -553,6 +555,7 @@ symmetric_hopf_curve_result trace_symmetric_hopf_curve(const F& family, double n
   }
   emit(make_point(x, h0.report.iterations, 1, 0.0, seconds_since(t_start), false));
   if (res.points.size() >= size_t(opt.max_points)) return finish(hopf_curve_stop::max_points, "max_points reached");
+  if (stop_requested) return finish(hopf_curve_stop::requested, "stop requested by stop_after");
 
   struct landing {
     int row;  // 0: mu, 1: nu
@@ -751,6 +754,7 @@ symmetric_hopf_curve_result trace_symmetric_hopf_curve(const F& family, double n
                                        xl ? "" : " (landing failed: the last point lies outside)"));
       }
       if (res.points.size() >= size_t(opt.max_points)) return finish(hopf_curve_stop::max_points, "max_points reached");
+      if (stop_requested) return finish(hopf_curve_stop::requested, "stop requested by stop_after");
     }
 
     // ---- accept ----
@@ -759,6 +763,7 @@ symmetric_hopf_curve_result trace_symmetric_hopf_curve(const F& family, double n
     add_step_costs();
     emit(make_point(xnew, iters, attempts, len, step_seconds, false));
     if (res.points.size() >= size_t(opt.max_points)) return finish(hopf_curve_stop::max_points, "max_points reached");
+    if (stop_requested) return finish(hopf_curve_stop::requested, "stop requested by stop_after");
     s = refresh_s(xnew);
     x_prev = std::move(x);
     rescale_p(x_prev, s);
