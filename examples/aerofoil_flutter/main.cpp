@@ -275,8 +275,33 @@ boundary arclength_bridge(const structural_case& c, const grid_level& g, const s
   // a fold in M smaller than half a listed step (medium grid: the curve turns back by ~1e-4 in M at
   // the Ubar* peak near M = 0.826 and forward again) is traced through; the points on its way
   // back are not boundary points (the observer skips them: the boundary jumps to the branch below)
+  // A RETRACE is different: at a kink the corrector can turn round and follow the curve back
+  // (measured on the medium grid at M = 0.8276: 18 points with M falling by 1e-5 each, each one
+  // near the stretch traced just before). Stop when a point comes within retrace_distance (in
+  // the tracer's metric; steps are 0.3-0.85 there) of the polyline of this trace's points before
+  // the last three. A genuine fold moves away from it in omega (medium grid, M = 0.826: >= 0.7).
+  std::vector<Eigen::Vector3d> trail;  // scaled (Ubar, M, omega) of the accepted points
+  const double retrace_distance = 0.1;
+  std::string why = "landed";
   ho.stop_after = [&](const hopf_curve_point& p) {
-    return (p.landed && p.nu > from.mach + 1e-9) || p.nu < m_hi - fold_tolerance;
+    const Eigen::Vector3d y(std::abs(p.mu) / ho.mu_scale, p.nu / ho.nu_scale, p.omega / ho.omega_scale);
+    const std::size_t n_old = trail.size() >= 3 ? trail.size() - 3 : 0;  // points before the last three
+    double d = n_old > 0 ? (trail[0] - y).norm() : INFINITY;
+    for (std::size_t k = 0; k + 1 < n_old; ++k) {
+      const Eigen::Vector3d a = trail[k], e = trail[k + 1] - a;
+      const double t = e.squaredNorm() > 0 ? std::clamp((y - a).dot(e) / e.squaredNorm(), 0.0, 1.0) : 0.0;
+      d = std::min(d, (a + t * e - y).norm());
+    }
+    trail.push_back(y);
+    if (d < retrace_distance) {
+      why = "retrace: the trace turned back along the curve at a kink";
+      return true;
+    }
+    if (p.nu < m_hi - fold_tolerance) {
+      why = "the curve turns back in M by more than " + fixed(fold_tolerance, 3);
+      return true;
+    }
+    return p.landed && p.nu > from.mach + 1e-9;
   };
   auto family = [&](double mach) { return make_system(g, mach, c.mu_s); };
   std::printf("    hand-over to pseudo-arclength continuation of the Hopf curve from M = %.5f (Ubar* = %.5f, omega* = "
@@ -292,7 +317,7 @@ boundary arclength_bridge(const structural_case& c, const grid_level& g, const s
   std::printf("    arclength: %zu points (%zu beyond M = %.5f), %d failed correctors, %d steps at fixed M or Ubar, "
               "%d nested steady solves, %.2f s; stop: %s\n",
               r.points.size(), out.size(), from.mach, r.failed_correctors, r.kink_steps, r.steady_solves, r.seconds,
-              r.stop_reason.c_str());
+              r.stop == hopf_curve_stop::requested ? why.c_str() : r.stop_reason.c_str());
   return out;
 }
 

@@ -7,6 +7,8 @@ boundaries.png  Ubar*(M) for both cases and grids, with the time-marching points
                 (filled: decaying at 0.97 Ubar*, crosses: growing at 1.03 Ubar*)
 spectra.png     very coarse light case M = 0.5: eigenvalues at Ubar* - 0.01, Ubar*, Ubar* + 0.01
 histories.png   pitch histories of the time-marching runs
+jump_check.png  very coarse grid: largest Re lambda of the whole spectrum against Ubar / Ubar*
+                at the Mach numbers where a boundary jumps to another mode (and the last one)
 reduced.png     reduced model (heavy case): damping vs the exact eigenvalue, growth rate vs
                 amplitude at Ubar*, LCO amplitude vs Ubar, against time marching
 """
@@ -115,6 +117,25 @@ def histories(out):
     save(fig, out, "histories.png")
 
 
+def jump_check(out):
+    path = os.path.join(out, "jump_check.csv")
+    if not os.path.exists(path):
+        return
+    rows = read(path)
+    fig, ax = plt.subplots(figsize=(7, 4.5))
+    keys = sorted({(r["case"], r["mach"], r["ubar_star"]) for r in rows})
+    for case, mach, us in keys:
+        sel = [r for r in rows if (r["case"], r["mach"], r["ubar_star"]) == (case, mach, us)]
+        x = [float(r["ubar"]) / float(us) for r in sel]
+        ax.plot(x, col(sel, "max_re"), "o-", ms=3, label=f"{case}, M = {float(mach):.4f} (Ubar* = {float(us):.3f})")
+    ax.axhline(0, color="gray", lw=0.8)
+    ax.axvline(1, color="gray", lw=0.8, ls="--")
+    ax.set_yscale("symlog", linthresh=1e-4)
+    finish_axes(ax, "$\\bar U / \\bar U^*$", "max Re $\\lambda$ (all eigenvalues)",
+                "very coarse grid: is the boundary point the lowest crossing?")
+    save(fig, out, "jump_check.png")
+
+
 def reduced(out):
     dpath = os.path.join(out, "reduced_damping.csv")
     lpath, mpath = os.path.join(out, "reduced_lco.csv"), os.path.join(out, "reduced_lco_march.csv")
@@ -161,6 +182,7 @@ def main():
     boundaries(out)
     spectra(out)
     histories(out)
+    jump_check(out)
     reduced(out)
     print("plots written to", out)
 
