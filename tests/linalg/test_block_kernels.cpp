@@ -72,7 +72,42 @@ void check_both_signs() {
   check_rows<S, B, -1>();
 }
 
+// real block row times a complex vector (the fused shifted product of a real matrix)
+template <int B>
+void check_real_complex_rows() {
+  std::mt19937 gen(99 + B);
+  const int n_seg = 9;
+  std::vector<cd> x(n_seg * B);
+  for (auto& v : x) v = random_value<cd>(gen);
+  std::uniform_int_distribution<int> col(0, n_seg - 1);
+  for (int count = 0; count <= 8; ++count) {
+    std::vector<double> a(std::size_t(count) * B * B);
+    for (auto& v : a) v = random_value<double>(gen);
+    internal::real_complex_row_accumulator<B> t;
+    Eigen::Matrix<cd, B, 1> ref = Eigen::Matrix<cd, B, 1>::Zero();
+    double scale = 0.0;
+    for (int q = 0; q < count; ++q) {
+      const int c = q == 1 ? 0 : col(gen);
+      const Eigen::Map<const Eigen::Matrix<double, B, B>> aq(a.data() + std::size_t(q) * B * B);
+      const Eigen::Map<const Eigen::Matrix<cd, B, 1>> xq(x.data() + std::size_t(c) * B);
+      ref += aq.template cast<cd>() * xq;
+      scale += aq.norm() * xq.norm();
+      t.add(a.data() + std::size_t(q) * B * B, x.data() + std::size_t(c) * B);
+    }
+    std::vector<cd> got(B, cd(7.0, 7.0));  // store() overwrites
+    t.store(got.data());
+    EXPECT_LE((Eigen::Map<const Eigen::Matrix<cd, B, 1>>(got.data()) - ref).norm(), 1e-15 * (scale + 1e-300))
+        << "B " << B << " blocks " << count;
+  }
+}
+
 }  // namespace
+
+TEST(block_kernels, real_matrix_complex_vector_rows_match_eigen) {
+  check_real_complex_rows<3>();
+  check_real_complex_rows<4>();
+  check_real_complex_rows<5>();
+}
 
 TEST(block_kernels, real_rows_match_eigen) {
   std::cout << "block kernel instruction set: " << internal::block_kernel_isa() << "\n";

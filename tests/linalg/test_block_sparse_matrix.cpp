@@ -151,6 +151,53 @@ TEST(BlockSparseMatrix, ShiftedComplexAndRealFormsAgreeWithDense) {
   EXPECT_LT((Eigen::MatrixXd(real_shifted_form(a, omega, real_form_ordering::split).to_sparse()) - expected).norm(), 1e-13);
 }
 
+// The fused real-matrix shifted product (A - sigma I) x on complex x against the dense complex
+// matrix and against the assembled shifted(A, sigma); B = 4, 5 (the vector kernels), a dynamic
+// block size (the portable loop) and a padded matrix (padded unknowns are not shifted).
+template <int B>
+void check_real_shifted_product(Eigen::Index bs, const cd sigma) {
+  const Eigen::Index nb = 11;
+  const auto t = random_triplets<double, B>(nb, bs, 5, 21);
+  const auto a = block_sparse_matrix<double, B>::from_triplets(nb, nb, t, bs);
+  const Eigen::Index n = nb * bs;
+  const Eigen::MatrixXcd dc = dense_of(t, nb, bs).template cast<cd>() - sigma * Eigen::MatrixXcd::Identity(n, n);
+  const vec<cd> x = vec<cd>::Random(n), x0 = x;
+  vec<cd> y(n), yc(n);
+  a.apply_shifted(sigma, x, y);
+  EXPECT_LT((y - dc * x).norm(), 1e-13 * (dc * x).norm()) << "B = " << bs;
+  shifted(a, sigma).apply(x, yc);
+  EXPECT_LT((y - yc).norm(), 1e-14 * yc.norm()) << "B = " << bs;
+  const shifted_operator<block_sparse_matrix<double, B>, cd> op(a, sigma);
+  vec<cd> yo(n);
+  apply_operator<cd>(op, x, yo);
+  EXPECT_EQ((yo - y).norm(), 0.0);
+  vec<cd> y0(n);
+  a.apply(x, y0);  // sigma = 0
+  EXPECT_LT((y0 - y - sigma * x).norm(), 1e-13 * y0.norm());
+  EXPECT_EQ(x, x0);  // input untouched
+  vec<cd> shorter(n - 1);
+  EXPECT_THROW(a.apply_shifted(sigma, shorter, y), input_error);
+  EXPECT_THROW(a.apply_shifted(sigma, x, shorter), input_error);
+}
+
+TEST(BlockSparseMatrix, RealShiftedProductOnComplexVectorsMatchesTheAssembledShiftedMatrix) {
+  check_real_shifted_product<4>(4, cd(0.0, 0.83));
+  check_real_shifted_product<5>(5, cd(0.1, -1.7));
+  check_real_shifted_product<Eigen::Dynamic>(3, cd(0.0, 0.4));
+  // padded: 11 unknowns in blocks of 4; the padded unknown keeps its identity row (not shifted)
+  const Eigen::Index n = 11;
+  Eigen::MatrixXd d = Eigen::MatrixXd::Random(n, n) + 5 * Eigen::MatrixXd::Identity(n, n);
+  const auto a = block_sparse_matrix<double, 4>::from_sparse(Eigen::SparseMatrix<double>(d.sparseView()));
+  const cd sigma(0.0, 0.9);
+  const vec<cd> x = vec<cd>::Random(n);
+  vec<cd> y(12), yc(12);
+  a.apply_shifted(sigma, pad_vector(x, 12), y);
+  shifted(a, sigma).apply(pad_vector(x, 12), yc);
+  EXPECT_LT((unpad_vector(y, n) - (d.cast<cd>() - sigma * Eigen::MatrixXcd::Identity(n, n)) * x).norm(), 1e-13);
+  EXPECT_LT((y - yc).norm(), 1e-14);
+  EXPECT_EQ(y(11), cd(0.0));
+}
+
 TEST(BlockSparseMatrix, BorderedOperatorMatchesDenseAssembly) {
   const Eigen::Index nb = 7, bs = 4, n = nb * bs, k = 2;
   const auto t = random_triplets<cd, 4>(nb, bs, 3, 11);

@@ -54,6 +54,20 @@ inline constexpr const char* block_kernel_isa() {
 #endif
 }
 
+#if defined(AEROHOPF_AVX2_BLOCK_KERNELS)
+/// The value, kept in a register. WHY: each complex matrix column is used by two fused
+/// multiply-adds (with Re x and Im x); left alone, the compiler folds the load into both, so every
+/// matrix value is loaded twice and the 5 x 5 complex block is bound by the load ports (measured
+/// in cache: 15.1 -> 12.8 ns per block with the single load).
+template <class V>
+inline V in_register(V v) {
+#if defined(__GNUC__)
+  __asm__("" : "+x"(v));
+#endif
+  return v;
+}
+#endif
+
 /// Partial sums of one block row: add(a, x) accumulates the B x B block a times the segment x;
 /// finish<Sign>(acc) does acc += Sign * sum. The primary template is the portable version.
 template <class S, int B>
@@ -92,12 +106,12 @@ struct row_accumulator<std::complex<double>, B> {
       const __m256d xr = _mm256_broadcast_sd(x + 2 * c), xi = _mm256_broadcast_sd(x + 2 * c + 1);
       const double* col = a + 2 * B * c;
       for (int v = 0; v < nv; ++v) {
-        const __m256d av = _mm256_loadu_pd(col + 4 * v);
+        const __m256d av = in_register(_mm256_loadu_pd(col + 4 * v));
         p[v] = _mm256_fmadd_pd(av, xr, p[v]);
         q[v] = _mm256_fmadd_pd(av, xi, q[v]);
       }
       if constexpr (odd) {
-        const __m128d av = _mm_loadu_pd(col + 4 * nv);
+        const __m128d av = in_register(_mm_loadu_pd(col + 4 * nv));
         p1 = _mm_fmadd_pd(av, _mm256_castpd256_pd128(xr), p1);
         q1 = _mm_fmadd_pd(av, _mm256_castpd256_pd128(xi), q1);
       }
@@ -214,6 +228,64 @@ struct row_accumulator<double, 5> {
 };
 
 #endif  // AEROHOPF_AVX2_BLOCK_KERNELS
+
+/// Partial sums of one block row of a REAL matrix times a COMPLEX vector: add(a, x) accumulates
+/// the real B x B block a times the complex segment x; store(y) writes the sum, interleaved
+/// (re, im) like std::complex. WHY: the shifted systems (A - sigma I) x of the Hopf and inverse
+/// power solves have a real A; applying it to complex vectors directly streams half the bytes
+/// of the assembled complex matrix. P = A Re x and Q = A Im x are accumulated in separate
+/// registers (same loads as the real kernel) and interleaved once per row.
+template <int B>
+struct real_complex_row_accumulator {
+  double re[B] = {}, im[B] = {};
+  inline void add(const double* __restrict a, const std::complex<double>* __restrict xc) {
+    const double* x = reinterpret_cast<const double*>(xc);
+    for (int c = 0; c < B; ++c) {
+      const double xr = x[2 * c], xi = x[2 * c + 1];
+      for (int r = 0; r < B; ++r) {
+        re[r] += a[c * B + r] * xr;
+        im[r] += a[c * B + r] * xi;
+      }
+    }
+  }
+  inline void store(std::complex<double>* __restrict yc) const {
+    double* y = reinterpret_cast<double*>(yc);
+    for (int r = 0; r < B; ++r) {
+      y[2 * r] = re[r];
+      y[2 * r + 1] = im[r];
+    }
+  }
+};
+
+#if defined(AEROHOPF_AVX2_BLOCK_KERNELS)
+// B = 4 and 5: rows 0-3 of a column in one register, times broadcast Re x_c and Im x_c; row 4 of
+// the 5 x 5 block as one 128-bit (a, a) * (Re x_c, Im x_c), already interleaved. Even and odd
+// columns go to separate accumulators (the FMA latency chain of a long block row).
+template <int B>
+  requires(B == 4 || B == 5)
+struct real_complex_row_accumulator<B> {
+  __m256d p[2] = {_mm256_setzero_pd(), _mm256_setzero_pd()}, q[2] = {_mm256_setzero_pd(), _mm256_setzero_pd()};
+  __m128d t4[2] = {_mm_setzero_pd(), _mm_setzero_pd()};
+  inline void add(const double* __restrict a, const std::complex<double>* __restrict xc) {
+    const double* x = reinterpret_cast<const double*>(xc);
+    for (int c = 0; c < B; ++c) {
+      const int s = c & 1;
+      const __m256d av = _mm256_loadu_pd(a + B * c);
+      p[s] = _mm256_fmadd_pd(av, _mm256_broadcast_sd(x + 2 * c), p[s]);
+      q[s] = _mm256_fmadd_pd(av, _mm256_broadcast_sd(x + 2 * c + 1), q[s]);
+      if constexpr (B == 5) t4[s] = _mm_fmadd_pd(_mm_loaddup_pd(a + B * c + 4), _mm_loadu_pd(x + 2 * c), t4[s]);
+    }
+  }
+  inline void store(std::complex<double>* __restrict yc) const {
+    double* y = reinterpret_cast<double*>(yc);
+    const __m256d pp = _mm256_add_pd(p[0], p[1]), qq = _mm256_add_pd(q[0], q[1]);
+    const __m256d lo = _mm256_unpacklo_pd(pp, qq), hi = _mm256_unpackhi_pd(pp, qq);  // (p0 q0 p2 q2), (p1 q1 p3 q3)
+    _mm256_storeu_pd(y, _mm256_permute2f128_pd(lo, hi, 0x20));
+    _mm256_storeu_pd(y + 4, _mm256_permute2f128_pd(lo, hi, 0x31));
+    if constexpr (B == 5) _mm_storeu_pd(y + 8, _mm_add_pd(t4[0], t4[1]));
+  }
+};
+#endif
 
 /// Software prefetch of the bytes [p + distance, p + distance + bytes) of a read-only stream,
 /// one request per 64-byte line. WHY: in the BILU sweeps each row waits for the previous row's
