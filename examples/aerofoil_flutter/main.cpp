@@ -106,6 +106,8 @@ int start_iterations = 1;     // --start-iterations (hopf_krylov_options::start_
 int start_restart = 50;       // --start-restart: GMRES restart of the inverse-power start (50: measured
                               // light medium start 5.0-5.8 s vs 6.9-7.3 s with 80; heavy equal)
 double start_tolerance = 1e-2;  // --start-tolerance (hopf_krylov_options::start_tolerance)
+int hopf_restart = 80;          // --hopf-restart: GMRES restart of the Hopf Newton corrections
+double hopf_forcing = 1.0;      // --hopf-forcing: hopf_krylov_options::forcing_exponent
 
 /// Newton criterion ||F|| <= tolerance on the Hopf system (p normalised by s.p = i at its
 /// largest component). Boundaries use 1e-7 (--hopf-tol): measured on the medium grid, Ubar*
@@ -207,6 +209,8 @@ std::optional<boundary_point> hopf_at(const aerofoil_system& s, double mach, con
   ko.start_iterations = start_iterations;
   ko.start_tolerance = start_tolerance;
   ko.start_residual_threshold = 10.0;  // subsonic continued guesses (||F|| 3-7) go straight to Newton
+  ko.krylov.restart = hopf_restart;
+  ko.forcing_exponent = hopf_forcing;
   hopf_options ho = hopf_opts(label, boundary_tolerance);
   // from a refined continuation start Newton needs 2-4 iterations (light medium, M 0.55-0.90);
   // a point still unconverged after 12 is abandoned for a smaller Mach step
@@ -944,6 +948,12 @@ int main(int argc, char** argv) {
       } else if (a == "--start-iterations") {
         start_iterations = std::stoi(next());
         require(start_iterations >= 0, "--start-iterations must be >= 0");
+      } else if (a == "--hopf-restart") {
+        hopf_restart = std::stoi(next());
+        require(hopf_restart >= 1, "--hopf-restart must be >= 1");
+      } else if (a == "--hopf-forcing") {
+        hopf_forcing = std::stod(next());
+        require(hopf_forcing > 0 && hopf_forcing <= 1, "--hopf-forcing must be in (0, 1]");
       } else if (a == "--start-restart") {
         start_restart = std::stoi(next());
         require(start_restart >= 1, "--start-restart must be >= 1");
