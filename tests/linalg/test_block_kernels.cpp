@@ -26,21 +26,26 @@ S random_value(std::mt19937& g) {
   else return u(g);
 }
 
+/// n values drawn by random_value, in order.
+template <class S>
+std::vector<S> random_values(std::mt19937& g, std::size_t n) {
+  std::vector<S> v(n);
+  for (auto& e : v) e = random_value<S>(g);
+  return v;
+}
+
 template <class S, int B, int Sign>
 void check_rows() {
   std::mt19937 gen(1234 + B * 10 + Sign);
   const int n_seg = 11;  // segments of x
-  std::vector<S> x(n_seg * B);
-  for (auto& v : x) v = random_value<S>(gen);
+  const std::vector<S> x = random_values<S>(gen, n_seg * B);
   std::uniform_int_distribution<int> col(0, n_seg - 1);
   for (int count = 0; count <= 9; ++count) {
-    std::vector<S> a(std::size_t(count) * B * B);
-    for (auto& v : a) v = random_value<S>(gen);
+    const std::vector<S> a = random_values<S>(gen, std::size_t(count) * B * B);
     std::vector<int> cols(count);
     for (auto& c : cols) c = col(gen);
     if (count >= 2) cols[1] = cols[0];  // a repeated column
-    std::vector<S> acc(B);
-    for (auto& v : acc) v = random_value<S>(gen);
+    std::vector<S> acc = random_values<S>(gen, B);
     // reference: acc0 + Sign * sum A_q x_q with Eigen
     Eigen::Matrix<S, B, 1> ref = Eigen::Map<const Eigen::Matrix<S, B, 1>>(acc.data());
     double scale = ref.norm();
@@ -56,10 +61,8 @@ void check_rows() {
     EXPECT_LE((got - ref).norm(), 1e-15 * scale) << "B " << B << " sign " << Sign << " blocks " << count;
   }
   // single-block product
-  std::vector<S> a1(B * B), x1(B), y1(B);
-  for (auto& v : a1) v = random_value<S>(gen);
-  for (auto& v : x1) v = random_value<S>(gen);
-  for (auto& v : y1) v = random_value<S>(gen);
+  const std::vector<S> a1 = random_values<S>(gen, B * B), x1 = random_values<S>(gen, B);
+  std::vector<S> y1 = random_values<S>(gen, B);
   Eigen::Matrix<S, B, 1> ref = Eigen::Map<const Eigen::Matrix<S, B, 1>>(y1.data());
   ref += double(Sign) * (Eigen::Map<const Eigen::Matrix<S, B, B>>(a1.data()) * Eigen::Map<const Eigen::Matrix<S, B, 1>>(x1.data()));
   internal::block_gemv<Sign, B>(a1.data(), x1.data(), y1.data());
@@ -77,12 +80,10 @@ template <int B>
 void check_real_complex_rows() {
   std::mt19937 gen(99 + B);
   const int n_seg = 9;
-  std::vector<cd> x(n_seg * B);
-  for (auto& v : x) v = random_value<cd>(gen);
+  const std::vector<cd> x = random_values<cd>(gen, n_seg * B);
   std::uniform_int_distribution<int> col(0, n_seg - 1);
   for (int count = 0; count <= 8; ++count) {
-    std::vector<double> a(std::size_t(count) * B * B);
-    for (auto& v : a) v = random_value<double>(gen);
+    const std::vector<double> a = random_values<double>(gen, std::size_t(count) * B * B);
     internal::real_complex_row_accumulator<B> t;
     Eigen::Matrix<cd, B, 1> ref = Eigen::Matrix<cd, B, 1>::Zero();
     double scale = 0.0;
