@@ -267,10 +267,10 @@ void bench_ilu(benchmark::State& state, std::function<problem<B>&()> get, form f
 }
 
 // ---- complete solves ---------------------------------------------------------------------------
-template <int B, class S>
 // real_operator: the Krylov method applies A - i omega I as the real A on complex vectors
 // (shifted_operator, one fused pass over the real matrix) instead of the assembled complex matrix;
 // the preconditioner is the same complex BILU(k) of the assembled matrix.
+template <int B, class S>
 void bench_solve(benchmark::State& state, std::function<problem<B>&()> get, form f, int method, int fill,
                  krylov_method km, double rtol, bool real_operator = false) {
   auto& p = get();
