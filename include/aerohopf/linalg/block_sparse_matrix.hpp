@@ -351,8 +351,8 @@ class block_sparse_matrix {
     if constexpr (B != Eigen::Dynamic) {
       for (index i = 0; i < nbr_; ++i) {
         const storage_index p0 = row_ptr_[i], p1 = row_ptr_[i + 1];
-        // the real block (half the bytes of a complex one) does half the work per byte of the complex
-        // kernel: here the prefetch pays (measured: 75-77 % of STREAM without, 79-97 % with)
+        // unlike the SpMV on the matrix's own scalar (block_kernels.hpp), this product gains from
+        // the prefetch (bench_linear_solver, same session: 75-77 % of STREAM without, 79-97 % with)
         internal::prefetch_ahead(v + index(p0) * B * B, index(p1 - p0) * B * B * index(sizeof(double)));
         internal::real_complex_row_accumulator<B> t;
         for (storage_index p = p0; p < p1; ++p) t.add(v + index(p) * B * B, xv + index(cols[p]) * B);
