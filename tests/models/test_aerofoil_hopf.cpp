@@ -9,6 +9,7 @@
 #include <gtest/gtest.h>
 
 #include <aerohopf/bifurcation/hopf.hpp>
+#include <aerohopf/bifurcation/hopf_bordered.hpp>
 #include <aerohopf/flow/naca_cgrid.hpp>
 #include <aerohopf/flow/steady_solver.hpp>
 #include <aerohopf/models/aerofoil.hpp>
@@ -37,7 +38,60 @@ std::pair<std::complex<double>, double> spectrum_near(const aerofoil_system& s, 
       other = std::max(other, ev[i].real());
   return {ev[best], other};
 }
+// The aerofoil seen only through the dynamical_system interface (Eigen sparse Jacobians):
+// solve_hopf_krylov then takes the from_sparse route instead of the model's block Jacobians.
+struct sparse_only {
+  const aerofoil_system& s;
+  using jacobian_type = aerofoil_system::jacobian_type;
+  Eigen::Index size() const { return s.size(); }
+  template <class T>
+  vec<T> residual(const vec<T>& w, const T& mu) const {
+    return s.residual<T>(w, mu);
+  }
+  jacobian_type jacobian(const vec<double>& w, double mu) const { return s.jacobian(w, mu); }
+  jacobian_type approximate_jacobian(const vec<double>& w, double mu) const { return s.approximate_jacobian(w, mu); }
+  vec<double> d_mu(const vec<double>& w, double mu) const { return s.d_mu(w, mu); }
+  jacobian_type jacobian_d_mu(const vec<double>& w, double mu) const { return s.jacobian_d_mu(w, mu); }
+};
+static_assert(has_block_jacobians<aerofoil_system, 4>);
+static_assert(!has_block_jacobians<sparse_only, 4>);
 }  // namespace
+
+TEST(aerofoil_hopf, block_jacobians_give_the_same_krylov_hopf_iterates_as_the_sparse_route) {
+  structure::pitch_plunge_parameters p;
+  p.mu_s = 10;
+  const aerofoil_system s(euler_model<2>(coarsen(naca_cgrid(), 8), {.mach = 0.5, .alpha_rad = 0.0}),
+                          structure::pitch_plunge(p));
+  const vec<double> w = s.steady_equilibrium();
+  // the blocks: cells + 1 block rows, the structural unknowns last, the same entries as jacobian()
+  vec<double> wd = w;
+  wd.tail(4) << 0.01, -0.02, 0.03, 0.01;  // a moved grid (the rigid-motion path of the assembly)
+  const auto blocks = s.block_jacobian(wd, 1.7);
+  EXPECT_EQ(blocks.block_rows(), s.size() / 4);
+  EXPECT_EQ(blocks.logical_rows(), s.size());
+  EXPECT_EQ(blocks.col_index()[blocks.row_ptr()[1] - 1], s.size() / 4 - 1);  // row 0 ends in the structure
+  const Eigen::SparseMatrix<double> dj = s.jacobian(wd, 1.7) - blocks.to_sparse();
+  EXPECT_EQ(dj.norm(), 0.0);
+  const Eigen::SparseMatrix<double> dl = s.approximate_jacobian(wd, 1.7) - s.approximate_block_jacobian(wd, 1.7).to_sparse();
+  EXPECT_EQ(dl.norm(), 0.0);
+
+  const hopf_point start = hopf_start(s, w, 1.75, 0.6);
+  hopf_options opt;
+  opt.symmetric = true;
+  opt.newton.abs_tolerance = 1e-9;
+  const hopf_result hb = solve_hopf_krylov<4>(s, start, opt);
+  const hopf_result hs = solve_hopf_krylov<4>(sparse_only{s}, start, opt);
+  ASSERT_TRUE(hb.report.converged);
+  ASSERT_TRUE(hs.report.converged);
+  EXPECT_EQ(hb.report.iterations, hs.report.iterations);
+  EXPECT_EQ(hb.linear_iterations, hs.linear_iterations);
+  EXPECT_NEAR(hb.point.mu, hs.point.mu, 1e-12);
+  EXPECT_NEAR(hb.point.omega, hs.point.omega, 1e-12);
+  // and it is the Hopf point of the dense check above (sparse LU of the augmented system)
+  const hopf_result hd = solve_hopf(s, start, opt);
+  EXPECT_NEAR(hb.point.mu, hd.point.mu, 1e-8);
+  EXPECT_NEAR(hb.point.omega, hd.point.omega, 1e-8);
+}
 
 TEST(aerofoil_hopf, light_case_flutter_point_matches_dense_spectrum) {
   structure::pitch_plunge_parameters p;

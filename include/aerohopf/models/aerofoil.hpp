@@ -25,6 +25,7 @@
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <utility>
@@ -158,6 +159,15 @@ class aerofoil_system {
   }
 
   jacobian_type jacobian(const vec<double>& w, double mu) const { return assemble(w, mu, flow::jacobian_kind::exact); }
+  /// The exact Jacobian in 4 x 4 blocks (the structural unknowns are the last block row and
+  /// column; no padding): what solve_hopf_krylov takes directly when a system offers it, saving
+  /// the Eigen round trip (triplets, sort, re-blocking: about half the assembly time, measured).
+  block_sparse_matrix<double, nv> block_jacobian(const vec<double>& w, double mu) const {
+    return assemble_blocks(w, mu, flow::jacobian_kind::exact);
+  }
+  block_sparse_matrix<double, nv> approximate_block_jacobian(const vec<double>& w, double mu) const {
+    return assemble_blocks(w, mu, flow::jacobian_kind::modified_order);
+  }
   /// Same with the modified-order flow block (left-hand side of Newton iterations).
   jacobian_type approximate_jacobian(const vec<double>& w, double mu) const {
     return assemble(w, mu, flow::jacobian_kind::modified_order);
@@ -228,8 +238,15 @@ class aerofoil_system {
   }
 
   jacobian_type assemble(const vec<double>& w, double mu, flow::jacobian_kind kind) const {
+    return assemble_blocks(w, mu, kind).to_sparse();
+  }
+
+  /// The coupled Jacobian in blocks of nv: block rows/columns 0..nc-1 the flow cells, block nc
+  /// the 4 structural unknowns. Pattern: the flow block's, plus the structural column in every
+  /// row (the rigid motion moves every cell) and, in the structural row, the wall cells.
+  block_sparse_matrix<double, nv> assemble_blocks(const vec<double>& w, double mu, flow::jacobian_kind kind) const {
     check_state(*this, w, mu, "aerofoil_system::jacobian");
-    std::vector<Eigen::Triplet<double>> t;
+    using sidx = block_sparse_matrix<double, nv>::storage_index;
     // A_ff on the moved grid.
     const vec<double> wf = w.head(nf_);
     block_sparse_matrix<double, nv> aff;
@@ -242,18 +259,44 @@ class aerofoil_system {
       moved.set_grid_motion(pts, &spd);
       flow::assemble_jacobian<2>(moved, wf, kind, aff);
     }
-    const auto sff = aff.to_sparse();
-    t.reserve(static_cast<std::size_t>(sff.nonZeros()) + 4 * static_cast<std::size_t>(size()) + 8 * 4 * walls_.size());
-    for (int k = 0; k < sff.outerSize(); ++k)
-      for (jacobian_type::InnerIterator it(sff, k); it; ++it) t.emplace_back(it.row(), it.col(), it.value());
-    // [A_fs; A_ss]: one jet pass per structural unknown.
+    const auto nc = static_cast<sidx>(nf_ / nv);
+    std::vector<sidx> wall_cells;
+    for (const auto& f : walls_) {
+      wall_cells.push_back(static_cast<sidx>(f.cell0));
+      wall_cells.push_back(static_cast<sidx>(f.cell1));
+    }
+    std::sort(wall_cells.begin(), wall_cells.end());
+    wall_cells.erase(std::unique(wall_cells.begin(), wall_cells.end()), wall_cells.end());
+    const auto& frp = aff.row_ptr();
+    const auto& fci = aff.col_index();
+    std::vector<sidx> rp(static_cast<std::size_t>(nc) + 2), ci;
+    ci.reserve(fci.size() + static_cast<std::size_t>(nc) + wall_cells.size() + 1);
+    for (sidx i = 0; i < nc; ++i) {  // flow row: its flow blocks (sorted), then the structural column nc
+      rp[i] = static_cast<sidx>(ci.size());
+      ci.insert(ci.end(), fci.begin() + frp[i], fci.begin() + frp[i + 1]);
+      ci.push_back(nc);
+    }
+    rp[nc] = static_cast<sidx>(ci.size());
+    ci.insert(ci.end(), wall_cells.begin(), wall_cells.end());
+    ci.push_back(nc);
+    rp[nc + 1] = static_cast<sidx>(ci.size());
+    block_sparse_matrix<double, nv> a;
+    a.set_pattern_csr(nc + 1, nc + 1, rp, ci);
+    a.set_zero(false);
+    constexpr std::ptrdiff_t bb = nv * nv;
+    for (sidx i = 0; i < nc; ++i)
+      std::copy(aff.values().begin() + frp[i] * bb, aff.values().begin() + frp[i + 1] * bb, a.values().begin() + rp[i] * bb);
+    // [A_fs; A_ss]: one jet pass per structural unknown; the last block of every row.
     using jet = taylor<double, 1>;
     vec<jet> wj = w.cast<jet>();
     for (int j = 0; j < 4; ++j) {
       wj[nf_ + j] = jet::variable(w[nf_ + j], 1.0);
       const vec<jet> rj = residual<jet>(wj, jet(mu));
       wj[nf_ + j] = jet(w[nf_ + j]);
-      for (Eigen::Index i = 0; i < size(); ++i) t.emplace_back(i, nf_ + j, rj[i][1]);
+      for (sidx i = 0; i <= nc; ++i) {
+        auto blk = a.block_at(rp[i + 1] - 1);
+        for (int u = 0; u < nv; ++u) blk(u, j) = rj[Eigen::Index(i) * nv + u][1];
+      }
     }
     // A_sf: loads are linear in the wall pressures; dp/dw of the wall cells by local jets.
     flow::multiblock_points<double, 2> pts;
@@ -266,17 +309,15 @@ class aerofoil_system {
       for (int which = 0; which < 2; ++which) {
         const Eigen::Index cell = which == 0 ? f.cell0 : f.cell1;
         const double weight = which == 0 ? 1.5 : -0.5;
+        auto blk = a.block(nc, cell);
         for (int v = 0; v < nv; ++v) {
           std::array<jet, nv> wc;
           for (int u = 0; u < nv; ++u) wc[u] = jet::variable(w[cell * nv + u], u == v ? 1.0 : 0.0);
           const double dp = weight * pressure_of<jet>(wc.data())[1];
-          for (int i = 0; i < 4; ++i)
-            t.emplace_back(nf_ + i, cell * nv + v, (minv(i, 1) * kl * l + minv(i, 3) * km * c) * dp);
+          for (int i = 0; i < 4; ++i) blk(i, v) += (minv(i, 1) * kl * l + minv(i, 3) * km * c) * dp;
         }
       }
     }
-    jacobian_type a(size(), size());
-    a.setFromTriplets(t.begin(), t.end());
     return a;
   }
 
