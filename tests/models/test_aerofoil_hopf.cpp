@@ -74,6 +74,10 @@ TEST(aerofoil_hopf, block_jacobians_give_the_same_krylov_hopf_iterates_as_the_sp
   EXPECT_EQ(dj.norm(), 0.0);
   const Eigen::SparseMatrix<double> dl = s.approximate_jacobian(wd, 1.7) - s.approximate_block_jacobian(wd, 1.7).to_sparse();
   EXPECT_EQ(dl.norm(), 0.0);
+  const auto [pe, pa] = s.block_jacobians(wd, 1.7);  // both at once, coupling blocks shared
+  EXPECT_EQ(pe.values(), blocks.values());
+  EXPECT_EQ(pa.values(), s.approximate_block_jacobian(wd, 1.7).values());
+  EXPECT_EQ(pa.col_index(), s.approximate_block_jacobian(wd, 1.7).col_index());
 
   const hopf_point start = hopf_start(s, w, 1.75, 0.6);
   hopf_options opt;

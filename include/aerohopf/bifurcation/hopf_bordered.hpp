@@ -57,6 +57,7 @@
 #include <iomanip>
 #include <optional>
 #include <string>
+#include <tuple>
 #include <utility>
 
 #include "../error.hpp"
@@ -285,10 +286,12 @@ hopf_result solve_hopf_bordered(const S& sys, const hopf_point& guess, const hop
 /// as block matrices of block size B, padded to a multiple of B with logical size n (e.g.
 /// models::aerofoil_system): solve_hopf_krylov then skips the Eigen sparse round trip
 /// (triplets, sort, re-blocking), about half of the assembly time on the NACA 0012 grids.
+/// block_jacobians(w, mu) gives both (exact, approximate) at once, sharing what they have in common.
 template <class S, int B>
 concept has_block_jacobians = requires(const S& s, const vec<double>& w, double mu) {
   { s.block_jacobian(w, mu) } -> std::same_as<block_sparse_matrix<double, B>>;
   { s.approximate_block_jacobian(w, mu) } -> std::same_as<block_sparse_matrix<double, B>>;
+  { s.block_jacobians(w, mu) } -> std::same_as<std::pair<block_sparse_matrix<double, B>, block_sparse_matrix<double, B>>>;
 };
 
 struct hopf_krylov_options {
@@ -374,10 +377,14 @@ hopf_result solve_hopf_krylov(const S& sys, const hopf_point& guess, const hopf_
   // and also serves as L when precondition_exact.
   auto refresh = [&](double mu, double om) {
     const auto t0 = clock::now();
+    block_sparse_matrix<double, B> l;
     if constexpr (has_block_jacobians<S, B>) {
-      a = sys.block_jacobian(w, mu);
-      require(a.rows() == padded && a.cols() == padded && a.logical_rows() == n, opt.label,
-              ": block_jacobian is ", a.logical_rows(), " (padded ", a.rows(), ") square, system ", n);
+      if (kopt.precondition_exact) a = sys.block_jacobian(w, mu);
+      else std::tie(a, l) = sys.block_jacobians(w, mu);
+      for (const auto* m : {&a, &l})
+        require((m == &l && kopt.precondition_exact) ||
+                    (m->rows() == padded && m->cols() == padded && m->logical_rows() == n),
+                opt.label, ": block Jacobian is ", m->logical_rows(), " (padded ", m->rows(), ") square, system ", n);
     } else {
       a = block_sparse_matrix<double, B>::from_sparse(sys.jacobian(w, mu), B);
     }
@@ -386,9 +393,6 @@ hopf_result solve_hopf_krylov(const S& sys, const hopf_point& guess, const hopf_
     if (kopt.precondition_exact) {
       ilu.compute(shifted(a, C(0.0, om)));
     } else if constexpr (has_block_jacobians<S, B>) {
-      const block_sparse_matrix<double, B> l = sys.approximate_block_jacobian(w, mu);
-      require(l.rows() == padded && l.logical_rows() == n, opt.label, ": approximate_block_jacobian has size ",
-              l.logical_rows(), ", system ", n);
       ilu.compute(shifted(l, C(0.0, om)));
     } else {
       ilu.compute(shifted(block_sparse_matrix<double, B>::from_sparse(lhs_jacobian(sys, w, mu), B), C(0.0, om)));
