@@ -10,6 +10,7 @@
 
 #include <aerohopf/bifurcation/hopf.hpp>
 #include <aerohopf/bifurcation/hopf_bordered.hpp>
+#include <aerohopf/bifurcation/hopf_curve_symmetric.hpp>
 #include <aerohopf/flow/naca_cgrid.hpp>
 #include <aerohopf/flow/steady_solver.hpp>
 #include <aerohopf/models/aerofoil.hpp>
@@ -38,10 +39,11 @@ std::pair<std::complex<double>, double> spectrum_near(const aerofoil_system& s, 
       other = std::max(other, ev[i].real());
   return {ev[best], other};
 }
-// The aerofoil seen only through the dynamical_system interface (Eigen sparse Jacobians):
-// solve_hopf_krylov then takes the from_sparse route instead of the model's block Jacobians.
-struct sparse_only {
-  const aerofoil_system& s;
+// The aerofoil seen only through the dynamical_system interface (Eigen sparse Jacobians): the
+// Krylov Hopf solver and the Hopf-curve tracer then take the from_sparse route instead of the
+// model's block Jacobians.
+struct sparse_owner {
+  aerofoil_system s;
   using jacobian_type = aerofoil_system::jacobian_type;
   Eigen::Index size() const { return s.size(); }
   template <class T>
@@ -53,15 +55,18 @@ struct sparse_only {
   vec<double> d_mu(const vec<double>& w, double mu) const { return s.d_mu(w, mu); }
   jacobian_type jacobian_d_mu(const vec<double>& w, double mu) const { return s.jacobian_d_mu(w, mu); }
 };
+static_assert(!has_block_jacobians<sparse_owner, 4>);
+aerofoil_system light_very_coarse(double mach) {
+  structure::pitch_plunge_parameters p;
+  p.mu_s = 10;
+  return aerofoil_system(euler_model<2>(coarsen(naca_cgrid(), 8), {.mach = mach, .alpha_rad = 0.0}),
+                         structure::pitch_plunge(p));
+}
 static_assert(has_block_jacobians<aerofoil_system, 4>);
-static_assert(!has_block_jacobians<sparse_only, 4>);
 }  // namespace
 
 TEST(aerofoil_hopf, block_jacobians_give_the_same_krylov_hopf_iterates_as_the_sparse_route) {
-  structure::pitch_plunge_parameters p;
-  p.mu_s = 10;
-  const aerofoil_system s(euler_model<2>(coarsen(naca_cgrid(), 8), {.mach = 0.5, .alpha_rad = 0.0}),
-                          structure::pitch_plunge(p));
+  const aerofoil_system s = light_very_coarse(0.5);
   const vec<double> w = s.steady_equilibrium();
   // the blocks: cells + 1 block rows, the structural unknowns last, the same entries as jacobian()
   vec<double> wd = w;
@@ -84,7 +89,7 @@ TEST(aerofoil_hopf, block_jacobians_give_the_same_krylov_hopf_iterates_as_the_sp
   opt.symmetric = true;
   opt.newton.abs_tolerance = 1e-9;
   const hopf_result hb = solve_hopf_krylov<4>(s, start, opt);
-  const hopf_result hs = solve_hopf_krylov<4>(sparse_only{s}, start, opt);
+  const hopf_result hs = solve_hopf_krylov<4>(sparse_owner{s}, start, opt);
   ASSERT_TRUE(hb.report.converged);
   ASSERT_TRUE(hs.report.converged);
   EXPECT_EQ(hb.report.iterations, hs.report.iterations);
@@ -129,4 +134,39 @@ TEST(aerofoil_hopf, light_case_flutter_point_matches_dense_spectrum) {
   EXPECT_GT(above.real(), 0.0);
   EXPECT_GT(std::abs(below.imag()), 0.1);  // a complex pair (flutter), not the divergence eigenvalue
   EXPECT_LT(other_below, 0.0);             // stable before flutter: it is the first crossing
+}
+
+TEST(aerofoil_hopf, hopf_curve_tracer_gives_the_same_points_with_block_jacobians) {
+  // three points of the light case's Hopf curve in (M, Ubar) from M = 0.5 on the very coarse
+  // grid, with the nested steady solves and bordered corrections on the model's block Jacobians
+  // and on the Eigen route: the same points, landed on M = 0.51
+  const double m0 = 0.5;
+  const aerofoil_system s0 = light_very_coarse(m0);
+  const vec<double> w = s0.steady_equilibrium();
+  hopf_options ho;
+  ho.symmetric = true;
+  hopf_point start = solve_hopf(s0, hopf_start(s0, w, 1.75, 0.6), ho).point;
+  hopf_curve_options co;
+  co.mu_scale = 0.5;
+  co.nu_scale = 0.01;
+  co.omega_scale = 0.05;
+  co.step = 0.5;
+  co.max_step = 0.5;
+  co.max_points = 3;
+  co.nu_targets = {0.51};
+  co.throw_on_failure = true;
+  symmetric_hopf_curve_options so;
+  so.steady.abs_tolerance = 1e-10;
+  const auto rb = trace_symmetric_hopf_curve<4>([](double m) { return light_very_coarse(m); }, m0, start, co, +1, so);
+  const auto rs =
+      trace_symmetric_hopf_curve<4>([](double m) { return sparse_owner{light_very_coarse(m)}; }, m0, start, co, +1, so);
+  ASSERT_EQ(rb.points.size(), 3u);
+  ASSERT_EQ(rs.points.size(), rb.points.size());
+  EXPECT_EQ(rb.linear_iterations, rs.linear_iterations);
+  for (std::size_t k = 0; k < rb.points.size(); ++k) {
+    EXPECT_NEAR(rb.points[k].nu, rs.points[k].nu, 1e-10) << k;
+    EXPECT_NEAR(rb.points[k].mu, rs.points[k].mu, 1e-9) << k;
+    EXPECT_NEAR(rb.points[k].omega, rs.points[k].omega, 1e-9) << k;
+  }
+  EXPECT_GT(rb.points.back().nu, m0);
 }

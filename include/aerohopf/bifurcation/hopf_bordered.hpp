@@ -294,6 +294,39 @@ concept has_block_jacobians = requires(const S& s, const vec<double>& w, double 
   { s.block_jacobians(w, mu) } -> std::same_as<std::pair<block_sparse_matrix<double, B>, block_sparse_matrix<double, B>>>;
 };
 
+namespace internal {
+/// The exact Jacobian of sys at (w, mu) in blocks of B (padded to a multiple of B, logical size
+/// n): the system's own block assembly if it has one (has_block_jacobians), else from_sparse.
+template <int B, dynamical_system S>
+block_sparse_matrix<double, B> exact_blocks(const S& sys, const vec<double>& w, double mu, const std::string& who) {
+  if constexpr (has_block_jacobians<S, B>) {
+    block_sparse_matrix<double, B> a = sys.block_jacobian(w, mu);
+    require(a.rows() == padded_block_count(sys.size(), B) * B && a.cols() == a.rows() && a.logical_rows() == sys.size(),
+            who, ": block_jacobian is ", a.logical_rows(), " (padded ", a.rows(), ") square, system ", sys.size());
+    return a;
+  } else {
+    return block_sparse_matrix<double, B>::from_sparse(sys.jacobian(w, mu), B);
+  }
+}
+/// (exact Jacobian, lhs_jacobian) in blocks of B, from one block_jacobians call when the system
+/// has it (shared coupling blocks), else two from_sparse conversions.
+template <int B, dynamical_system S>
+std::pair<block_sparse_matrix<double, B>, block_sparse_matrix<double, B>> exact_and_lhs_blocks(
+    const S& sys, const vec<double>& w, double mu, const std::string& who) {
+  if constexpr (has_block_jacobians<S, B>) {
+    auto pair = sys.block_jacobians(w, mu);
+    for (const auto* m : {&pair.first, &pair.second})
+      require(m->rows() == padded_block_count(sys.size(), B) * B && m->cols() == m->rows() &&
+                  m->logical_rows() == sys.size(),
+              who, ": block Jacobian is ", m->logical_rows(), " (padded ", m->rows(), ") square, system ", sys.size());
+    return pair;
+  } else {
+    return {block_sparse_matrix<double, B>::from_sparse(sys.jacobian(w, mu), B),
+            block_sparse_matrix<double, B>::from_sparse(lhs_jacobian(sys, w, mu), B)};
+  }
+}
+}  // namespace internal
+
 struct hopf_krylov_options {
   int fill_level = 0;               ///< k of the complex BILU(k) of L - i omega I
   krylov_options krylov = [] {
@@ -378,25 +411,11 @@ hopf_result solve_hopf_krylov(const S& sys, const hopf_point& guess, const hopf_
   auto refresh = [&](double mu, double om) {
     const auto t0 = clock::now();
     block_sparse_matrix<double, B> l;
-    if constexpr (has_block_jacobians<S, B>) {
-      if (kopt.precondition_exact) a = sys.block_jacobian(w, mu);
-      else std::tie(a, l) = sys.block_jacobians(w, mu);
-      for (const auto* m : {&a, &l})
-        require((m == &l && kopt.precondition_exact) ||
-                    (m->rows() == padded && m->cols() == padded && m->logical_rows() == n),
-                opt.label, ": block Jacobian is ", m->logical_rows(), " (padded ", m->rows(), ") square, system ", n);
-    } else {
-      a = block_sparse_matrix<double, B>::from_sparse(sys.jacobian(w, mu), B);
-    }
+    if (kopt.precondition_exact) a = internal::exact_blocks<B>(sys, w, mu, opt.label);
+    else std::tie(a, l) = internal::exact_and_lhs_blocks<B>(sys, w, mu, opt.label);
     amu = jacobian_d_mu(sys, w, mu);
     mu0 = mu;
-    if (kopt.precondition_exact) {
-      ilu.compute(shifted(a, C(0.0, om)));
-    } else if constexpr (has_block_jacobians<S, B>) {
-      ilu.compute(shifted(l, C(0.0, om)));
-    } else {
-      ilu.compute(shifted(block_sparse_matrix<double, B>::from_sparse(lhs_jacobian(sys, w, mu), B), C(0.0, om)));
-    }
+    ilu.compute(shifted(kopt.precondition_exact ? a : l, C(0.0, om)));
     setup_seconds += since(t0);
   };
   if (kopt.reuse_matrices) refresh(x[N - 2], x[N - 1]);

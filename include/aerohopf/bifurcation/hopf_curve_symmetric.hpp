@@ -101,6 +101,7 @@
 #include <limits>
 #include <optional>
 #include <string>
+#include <tuple>
 #include <utility>
 #include <vector>
 
@@ -263,7 +264,6 @@ symmetric_hopf_curve_result trace_symmetric_hopf_curve(const F& family, double n
     r.head(n) = v;
     return r;
   };
-  auto blocked = [&](const M& m) { return real_block::from_sparse(m, B); };
 
   // ---- nested steady solves, cached by nu ----
   struct equilibrium {
@@ -298,8 +298,13 @@ symmetric_hopf_curve_result trace_symmetric_hopf_curve(const F& family, double n
       newton_result nr = newton_iterate(
           [&](const vec<double>& v) { return vec<double>(sys.residual(v, mu)); },
           [&](const vec<double>& v, const vec<double>& f, int k) {
-            a = blocked(sys.jacobian(v, mu));
-            if (k == 1) rilu.compute(blocked(lhs_jacobian(sys, v, mu)));
+            if (k == 1) {
+              real_block l;
+              std::tie(a, l) = internal::exact_and_lhs_blocks<B>(sys, v, mu, what);
+              rilu.compute(l);
+            } else {
+              a = internal::exact_blocks<B>(sys, v, mu, what);
+            }
             const double fn = f.norm();
             const double eta = std::min(sopt.eta_max, std::max(fn, 0.1 * sopt.steady.abs_tolerance / fn));
             return vec<double>(gmres_real(a, vec<double>(-f), std::min(eta, 0.5), what + ", GMRES"));
@@ -345,7 +350,8 @@ symmetric_hopf_curve_result trace_symmetric_hopf_curve(const F& family, double n
       if (std::abs(e.nu - nu) < std::abs(best->nu - nu)) best = &e;
     if (best->dw.size() != n) {
       const S& sb = system_at(aux, best->nu);
-      ensure_derivative(*best, mu, blocked(sb.jacobian(best->w, mu)), blocked(lhs_jacobian(sb, best->w, mu)));
+      const auto [a, lb] = internal::exact_and_lhs_blocks<B>(sb, best->w, mu, lab);
+      ensure_derivative(*best, mu, a, lb);
     }
     // warm starts in turn: linear extrapolation, the nearest equilibrium, the user's start
     vec<double> w;
@@ -398,8 +404,7 @@ symmetric_hopf_curve_result trace_symmetric_hopf_curve(const F& family, double n
     const vec<double>& w = e.w;
     const S& sys = system_at(cur, nu);
     const vec<double> pr = x.segment(ipr, n), pi = x.segment(ipi, n);
-    const real_block a = blocked(sys.jacobian(w, mu));
-    const real_block lb = blocked(lhs_jacobian(sys, w, mu));
+    const auto [a, lb] = internal::exact_and_lhs_blocks<B>(sys, w, mu, lab);
     ensure_derivative(e, mu, a, lb);
     const M amu = jacobian_d_mu(sys, w, mu);
     // G_nu by central differences along the linearly extrapolated equilibrium (file comment)
