@@ -96,17 +96,15 @@ TEST(aerofoil_hopf, block_jacobians_give_the_same_krylov_hopf_iterates_as_the_sp
   EXPECT_EQ(hb.linear_iterations, hs.linear_iterations);
   EXPECT_NEAR(hb.point.mu, hs.point.mu, 1e-12);
   EXPECT_NEAR(hb.point.omega, hs.point.omega, 1e-12);
-  // and it is the Hopf point of the dense check above (sparse LU of the augmented system)
+  // and it is the Hopf point of solve_hopf (Newton with the sparse LU of the full augmented
+  // system), the one the dense-spectrum test below checks
   const hopf_result hd = solve_hopf(s, start, opt);
   EXPECT_NEAR(hb.point.mu, hd.point.mu, 1e-8);
   EXPECT_NEAR(hb.point.omega, hd.point.omega, 1e-8);
 }
 
 TEST(aerofoil_hopf, light_case_flutter_point_matches_dense_spectrum) {
-  structure::pitch_plunge_parameters p;
-  p.mu_s = 10;
-  const aerofoil_system s(euler_model<2>(coarsen(naca_cgrid(), 8), {.mach = 0.5, .alpha_rad = 0.0}),
-                          structure::pitch_plunge(p));
+  const aerofoil_system s = light_very_coarse(0.5);
   const vec<double> w = s.steady_equilibrium();
 
   const hopf_point start = hopf_start(s, w, 1.75, 0.6);

@@ -295,14 +295,21 @@ concept has_block_jacobians = requires(const S& s, const vec<double>& w, double 
 };
 
 namespace internal {
+/// A model's own block Jacobian must have the padded size of the system (logical size n).
+template <int B, dynamical_system S>
+const block_sparse_matrix<double, B>& checked_block_size(const S& sys, const block_sparse_matrix<double, B>& m,
+                                                         const std::string& who) {
+  require(m.rows() == padded_block_count(sys.size(), B) * B && m.cols() == m.rows() && m.logical_rows() == sys.size(),
+          who, ": block Jacobian is ", m.logical_rows(), " (padded ", m.rows(), ") square, system ", sys.size());
+  return m;
+}
 /// The exact Jacobian of sys at (w, mu) in blocks of B (padded to a multiple of B, logical size
 /// n): the system's own block assembly if it has one (has_block_jacobians), else from_sparse.
 template <int B, dynamical_system S>
 block_sparse_matrix<double, B> exact_blocks(const S& sys, const vec<double>& w, double mu, const std::string& who) {
   if constexpr (has_block_jacobians<S, B>) {
     block_sparse_matrix<double, B> a = sys.block_jacobian(w, mu);
-    require(a.rows() == padded_block_count(sys.size(), B) * B && a.cols() == a.rows() && a.logical_rows() == sys.size(),
-            who, ": block_jacobian is ", a.logical_rows(), " (padded ", a.rows(), ") square, system ", sys.size());
+    checked_block_size(sys, a, who);
     return a;
   } else {
     return block_sparse_matrix<double, B>::from_sparse(sys.jacobian(w, mu), B);
@@ -315,10 +322,8 @@ std::pair<block_sparse_matrix<double, B>, block_sparse_matrix<double, B>> exact_
     const S& sys, const vec<double>& w, double mu, const std::string& who) {
   if constexpr (has_block_jacobians<S, B>) {
     auto pair = sys.block_jacobians(w, mu);
-    for (const auto* m : {&pair.first, &pair.second})
-      require(m->rows() == padded_block_count(sys.size(), B) * B && m->cols() == m->rows() &&
-                  m->logical_rows() == sys.size(),
-              who, ": block Jacobian is ", m->logical_rows(), " (padded ", m->rows(), ") square, system ", sys.size());
+    checked_block_size(sys, pair.first, who);
+    checked_block_size(sys, pair.second, who);
     return pair;
   } else {
     return {block_sparse_matrix<double, B>::from_sparse(sys.jacobian(w, mu), B),
