@@ -22,7 +22,7 @@
 //   --contact-smoothing d       contact-switch smoothing of the reduced-model part (default 0.05;
 //                               0 = exact Osher switch, whose residual is not C2 at the equilibrium)
 //   --quick                     coarse grid, M = 0.5 .. 0.8 step 0.1, shorter time marching
-//   --verbose                   a line per Hopf Newton iteration
+//   --verbose                   a line per Hopf Newton iteration (and per arclength corrector iteration)
 //
 // Outputs under out_dir (default out/aerofoil_flutter):
 //   flutter_point_very_coarse.txt, spectra.csv (ubar,re,im)     very coarse, light, M = 0.5
@@ -227,6 +227,11 @@ std::optional<boundary_point> hopf_at(const aerofoil_system& s, double mach, con
   // from a refined continuation start Newton needs 2-4 iterations (light medium, M 0.55-0.90);
   // a point still unconverged after 12 is abandoned for a smaller Mach step
   ho.newton.max_iterations = 12;
+  // ... and abandoned as soon as ||F|| rises after the first step (newton_options::max_contraction):
+  // measured on the heavy medium boundary, every Hopf Newton run that converged was monotone from
+  // its first step on, while the failures near M = 0.83 rose at iterations 2-4 and then wandered
+  // (mu -> 1e77) until iteration 8-12
+  ho.newton.max_contraction = 1.0;
   const auto t0 = clk::now();
   try {
     hopf_result h = solve_hopf_krylov<4>(s, g, ho, ko);
@@ -278,6 +283,7 @@ boundary arclength_bridge(const structural_case& c, const grid_level& g, const s
   ho.label = c.name + " " + g.name + " arclength";
   ho.start.newton.abs_tolerance = boundary_tolerance;
   ho.newton.abs_tolerance = boundary_tolerance;
+  if (verbose_newton) ho.newton.observer = newton_progress("      corrector");
   double m_hi = from.mach;
   const double fold_tolerance = 0.005;
   boundary out;

@@ -307,6 +307,41 @@ TEST(hopf_curve_symmetric, refuses_bad_input_and_reports_step_failure) {
   EXPECT_GT(r.points.back().nu, 0.69);
 }
 
+// iterate_distance: a corrector iterate farther than iterate_distance x step from its prediction
+// is abandoned before the equilibrium at its nu is solved. With a radius below the corrector's
+// first move every step fails, the trace reports why and the family is never built away from a
+// prediction; the default radius leaves the circle's trace unchanged.
+TEST(hopf_curve_symmetric, abandons_a_corrector_that_leaves_the_trust_radius) {
+  std::vector<double> built;
+  auto family = [&](double nu) {
+    built.push_back(nu);
+    return circle_family_system(nu);
+  };
+  const hopf_point start = circle_start(0.6, 0.78, 1.2);
+  hopf_curve_options o = circle_options();
+  o.verbose = false;
+  o.throw_on_failure = false;
+  o.min_step = 0.05;
+  symmetric_hopf_curve_options so;
+  so.iterate_distance = 1e-9;
+  const auto r = trace_symmetric_hopf_curve<2>(family, 0.6, start, o, 1, so);
+  EXPECT_EQ(r.stop, hopf_curve_stop::step_failure);
+  EXPECT_EQ(r.points.size(), 1u);
+  EXPECT_NE(r.stop_reason.find("from the prediction (more than"), std::string::npos) << r.stop_reason;
+  EXPECT_GE(r.failed_correctors, 1);
+  // only the start and the predictions were built: each lies within one step of nu0 = 0.6
+  for (double nu : built) EXPECT_LE(std::abs(nu - 0.6), o.step * o.nu_scale + 1e-12) << nu;
+  built.clear();
+  const auto same = trace_symmetric_hopf_curve<2>(family, 0.6, start, o, 1, symmetric_hopf_curve_options{});
+  so = {};
+  so.iterate_distance = std::numeric_limits<double>::infinity();
+  const auto off = trace_symmetric_hopf_curve<2>(family, 0.6, start, o, 1, so);
+  ASSERT_EQ(same.points.size(), off.points.size());
+  for (std::size_t k = 0; k < same.points.size(); ++k) EXPECT_EQ(same.points[k].nu, off.points[k].nu) << k;
+  so.iterate_distance = 0;
+  EXPECT_THROW(trace_symmetric_hopf_curve<2>(family, 0.6, start, o, 1, so), input_error);
+}
+
 // Heavy case (mu_s = 100) on the very coarse grid (stride 8, as the example), from M = 0.78 to
 // the landed point at M = 0.79.
 TEST(hopf_curve_symmetric, aerofoil_heavy_very_coarse_matches_fixed_mach_hopf_solve) {

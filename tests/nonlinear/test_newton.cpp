@@ -114,3 +114,66 @@ TEST(newton, RejectsNonFiniteStateWithoutTouchingIt) {
   EXPECT_EQ(w.head(5), copy.head(5));
   EXPECT_THROW(newton(r, vec<double>::Ones(3), 0.1), input_error);
 }
+
+// The contraction (monotonicity) test: off by default; when set, an iteration whose residual
+// ratio exceeds max_contraction fails at once, naming the iterate, and a contracting iteration
+// is not affected.
+TEST(newton, ContractionTestStopsANonContractingIterationEarly) {
+  // f = w^2 + 1 has no real root; Newton is w <- (w - 1/w)/2 (chaotic). From w = 0.5 the
+  // residuals are 1.25, 1.5625 (k = 1, not tested: contraction_from = 2), 1.085, 3.46 (k = 3).
+  no_root f;
+  newton_options o;
+  o.max_iterations = 30;
+  o.throw_on_failure = false;
+  const auto plain = newton(f, vec<double>::Constant(1, 0.5), 0.0, o);
+  EXPECT_FALSE(plain.report.converged);
+  EXPECT_EQ(plain.report.iterations, 30);
+  o.max_contraction = 1.0;
+  const auto r = newton(f, vec<double>::Constant(1, 0.5), 0.0, o);
+  EXPECT_FALSE(r.report.converged);
+  EXPECT_EQ(r.report.iterations, 3);
+  EXPECT_NE(r.report.reason.find("not contracting at iterate 3"), std::string::npos) << r.report.reason;
+  const auto& h = r.report.residual_history;
+  ASSERT_EQ(h.size(), 4u);
+  EXPECT_GT(h[1], h[0]);  // the first step may raise ||F||
+  EXPECT_GT(h[3], h[2]);
+  o.throw_on_failure = true;
+  EXPECT_THROW(newton(f, vec<double>::Constant(1, 0.5), 0.0, o), convergence_error);
+  o.max_contraction = 0.0;
+  EXPECT_THROW(newton(f, vec<double>::Constant(1, 0.5), 0.0, o), input_error);
+}
+
+TEST(newton, ContractionTestLeavesContractingIterationsAlone) {
+  // quadratic: the residual ratios fall with ||F||, so a strict bound does not bite
+  circle c;
+  newton_options o;
+  o.max_contraction = 0.5;
+  const auto q = newton(c, vec<double>::Constant(2, 3.0), 2.0, o);
+  ASSERT_TRUE(q.report.converged) << q.report.reason;
+  EXPECT_NEAR(q.x[0], 2.0, 1e-12);
+  // linear (chord): the rate q is measured without the test; a bound above it leaves the
+  // iteration unchanged, a bound below it stops it at the first tested iterate
+  tubular_reactor r(32);
+  newton_options base;
+  base.abs_tolerance = 1e-11;
+  base.max_iterations = 200;
+  const auto chord = newton_chord(r, r.rest_state(), 0.1, base);
+  ASSERT_TRUE(chord.report.converged);
+  const auto& h = chord.report.residual_history;
+  double worst = 0;
+  for (size_t k = 2; k < h.size(); ++k) worst = std::max(worst, h[k] / h[k - 1]);
+  ASSERT_LT(worst, 1.0);
+  newton_options loose = base;
+  loose.max_contraction = std::min(1.0, 1.5 * worst);
+  const auto same = newton_chord(r, r.rest_state(), 0.1, loose);
+  ASSERT_TRUE(same.report.converged);
+  EXPECT_EQ(same.report.iterations, chord.report.iterations);
+  EXPECT_EQ((same.x - chord.x).norm(), 0.0);
+  newton_options tight = base;
+  tight.max_contraction = 0.5 * (h[2] / h[1]);
+  tight.throw_on_failure = false;
+  const auto stopped = newton_chord(r, r.rest_state(), 0.1, tight);
+  EXPECT_FALSE(stopped.report.converged);
+  EXPECT_EQ(stopped.report.iterations, 2);
+  EXPECT_NE(stopped.report.reason.find("not contracting at iterate 2"), std::string::npos) << stopped.report.reason;
+}

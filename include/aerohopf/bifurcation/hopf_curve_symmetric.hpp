@@ -81,6 +81,10 @@
 // Nested steady solves that fail from the extrapolated start are retried from the nearest
 // solved equilibrium and then from equilibrium_start(nu) if given (transonic flow: the shock
 // moves fast with M, and Newton from the extrapolation can meet non-physical states).
+// Cheap failure: a corrector iterate farther than iterate_distance steps from its prediction is
+// abandoned before the nested steady solve at its nu, and opt.newton.max_contraction (the
+// contraction test of newton.hpp) abandons a corrector whose ||F|| rises after its first step;
+// each corrector iteration costs a steady solve, so a failed one should cost two or three.
 //
 // Everything else mirrors hopf_curve.hpp and uses its option and result types: metric and
 // step control (halve on failure, grow after <= fast_iterations, clamp), retry along the exact
@@ -167,6 +171,13 @@ struct symmetric_hopf_curve_options {
   /// from the free stream (aerofoil_system::steady_equilibrium). Empty: no third start.
   std::function<vec<double>(double)> equilibrium_start;
   double kink_distance = 2.0;
+  /// Abandon a corrector as soon as an iterate lies farther than iterate_distance x the step from
+  /// its prediction (the metric of hopf_curve_options), BEFORE the nested steady solve at that
+  /// iterate's nu: accepted points lie within corrector_distance (arclength) or kink_distance + 1
+  /// (fixed mu or nu) steps of it, and an iterate far outside is a corrector on its way out
+  /// (measured on the heavy medium grid: nu jumped from 0.828 to 0.066, where three steady starts
+  /// failed, 24 steady Newton iterations). Infinity: off.
+  double iterate_distance = 5.0;
   /// Called for every accepted point with its costs (after hopf_curve_options::observer).
   std::function<void(const hopf_curve_point&, const symmetric_hopf_curve_stats&)> observer;
 };
@@ -201,6 +212,7 @@ symmetric_hopf_curve_result trace_symmetric_hopf_curve(const F& family, double n
   require(sopt.steady.abs_tolerance > 0 && sopt.steady.max_iterations >= 1, lab,
           ": nested steady Newton needs abs_tolerance > 0 and max_iterations >= 1");
   require(std::isfinite(start.mu) && std::isfinite(start.omega), lab, ": start mu or omega is not finite");
+  require(sopt.iterate_distance > 0, lab, ": iterate_distance must be > 0 (got ", sopt.iterate_distance, ")");
 
   symmetric_hopf_curve_result res;
   symmetric_hopf_curve_stats acc;  // costs since the last accepted point
@@ -441,13 +453,22 @@ symmetric_hopf_curve_result trace_symmetric_hopf_curve(const F& family, double n
     int iterations = 0;
   };
   std::string last_failure;
-  auto correct = [&](const vec<double>& x0, const vec<double>& s, const double* c,
-                     double value) -> std::optional<corrected> {
+  auto correct = [&](const vec<double>& x0, const vec<double>& s, const double* c, double value,
+                     double radius) -> std::optional<corrected> {
     newton_options no = opt.newton;
     no.throw_on_failure = true;
     try {
       newton_result nr = newton_iterate(
-          [&](const vec<double>& x) { return residual(x, s, c, value); },
+          [&](const vec<double>& x) {
+            double d2 = 0;
+            for (int j = 0; j < 3; ++j)
+              if (sig[j] > 0) d2 += (yv(x, j) - yv(x0, j)) * (yv(x, j) - yv(x0, j)) / (sig[j] * sig[j]);
+            if (!(std::sqrt(d2) <= radius))
+              throw convergence_error(internal::concat(lab, " corrector: iterate at nu = ", x[inu], ", mu = ", x[imu],
+                                                       " lies ", std::sqrt(d2), " from the prediction (more than ",
+                                                       radius, ")"));
+            return residual(x, s, c, value);
+          },
           [&](const vec<double>& x, const vec<double>& f, int it) {
             const double fn = f.norm();
             double tol = sopt.krylov.relative_tolerance;
@@ -608,7 +629,7 @@ symmetric_hopf_curve_result trace_symmetric_hopf_curve(const F& family, double n
         c[j] = sig[j] > 0 ? yv(t, j) / (sig[j] * sig[j]) : 0.0;
         value += c[j] * yv(xp, j);
       }
-      xn = correct(xp, s, c, value);
+      xn = correct(xp, s, c, value, sopt.iterate_distance * ds);
       if (xn) {
         const double moved = ydist(xn->x, xp);
         const vec<double> d = xn->x - x;
@@ -659,7 +680,7 @@ symmetric_hopf_curve_result trace_symmetric_hopf_curve(const F& family, double n
         for (int j : order) {
           double c[3] = {0, 0, 0};
           c[j] = 1;
-          auto xk = correct(xp, s, c, yv(xp, j));
+          auto xk = correct(xp, s, c, yv(xp, j), sopt.iterate_distance * ds);
           if (xk) {
             const double dist = ydist(xk->x, x);
             const bool forward = ydot(vec<double>(xk->x - x), t_secant) > 0 && !revisits(xk->x, ds);
@@ -740,7 +761,7 @@ symmetric_hopf_curve_result trace_symmetric_hopf_curve(const F& family, double n
       const vec<double> x0 = x + theta * (xnew - x);
       double c[3] = {0, 0, 0};
       c[l.row] = 1;
-      auto xl = correct(x0, s, c, l.value);
+      auto xl = correct(x0, s, c, l.value, sopt.iterate_distance * ds);
       if (xl) {
         emit(make_point(xl->x, xl->iterations, 1, ydist(xl->x, x), seconds_since(t_land), true));
       } else {

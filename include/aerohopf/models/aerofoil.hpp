@@ -184,7 +184,9 @@ class aerofoil_system {
   vec<double> d_mu(const vec<double>& w, double mu) const {
     check_state(*this, w, mu, "aerofoil_system::d_mu");
     vec<double> r = vec<double>::Zero(size());
-    r.tail(4) = -structure_.mass_inverse() * structure_.stiffness_d_ubar(mu) * w.tail(4);
+    const Eigen::Matrix4d b = -structure_.mass_inverse() * structure_.stiffness_d_ubar(mu);
+    const Eigen::Vector4d q = w.tail<4>();
+    r.tail<4>() = b * q;  // fixed-size operands (GCC 12 + AVX-512 misreads the dynamic-block product)
     return r;
   }
   jacobian_type jacobian_d_mu(const vec<double>& w, double mu) const {

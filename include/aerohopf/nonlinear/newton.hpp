@@ -23,12 +23,20 @@
 // scaled by `relaxation` until ||F|| has dropped below relax_until ||F_0||, then full steps
 // (the start-up strategy reported for the augmented Hopf system); an optional backtracking
 // line search halves a step that does not decrease ||F||.
+// Contraction test (off by default): from iteration contraction_from on, an iteration whose
+// residual ratio ||F(x_k)|| / ||F(x_{k-1})|| exceeds max_contraction fails at once ("not
+// contracting"). Newton's residual ratio in the region of quadratic convergence is ~||F_k||,
+// and a ratio near or above 1 after the first steps means the start is outside that region (a
+// monotonicity test after Deuflhard). Callers with a fallback (continuation correctors that halve
+// the step, a retry along another direction) use it so that a corrector that will not converge
+// costs two or three iterations, not max_iterations.
 #include <Eigen/Core>
 
 #include <chrono>
 #include <cmath>
 #include <functional>
 #include <iomanip>
+#include <limits>
 #include <iostream>
 #include <string>
 #include <vector>
@@ -56,6 +64,11 @@ struct newton_options {
   double relaxation = 1.0;     ///< initial step scaling psi in (0, 1]
   double relax_until = 0.5;    ///< use psi until ||F|| < relax_until ||F_0||, then full steps
   bool line_search = false;    ///< halve the step (up to 10 times) while ||F|| does not decrease
+  /// Fail when ||F(x_k)|| > max_contraction ||F(x_{k-1})|| at an iteration k >= contraction_from
+  /// (infinity: never). The first step of a continuation corrector may raise ||F|| (the
+  /// predictor's residual is small but its error is not), hence contraction_from = 2.
+  double max_contraction = std::numeric_limits<double>::infinity();
+  int contraction_from = 2;
   bool throw_on_failure = true;
   std::function<void(const newton_step_info&)> observer;  ///< called after every step
 };
@@ -106,6 +119,7 @@ newton_result newton_iterate(ResidualFn&& residual, StepFn&& solve_step, vec<dou
   };
   for (Eigen::Index i = 0; i < x.size(); ++i)
     require(std::isfinite(x[i]), what, ": initial iterate entry ", i, " is not finite");
+  require(opt.max_contraction > 0, what, ": max_contraction must be > 0 (got ", opt.max_contraction, ")");
   vec<double> f = residual(x);
   double fn = internal::norm_or_nan(f);
   if (!std::isfinite(fn)) return fail("residual at the initial iterate is not finite");
@@ -156,6 +170,10 @@ newton_result newton_iterate(ResidualFn&& residual, StepFn&& solve_step, vec<dou
     if (opt.observer) opt.observer({k, fn, psi * dxn, psi, &x});
     if (fn > opt.divergence_factor * std::max(f0, 1e-300))
       return fail(internal::concat("diverged at iterate ", k, " (||F|| = ", fn, " from ", f0, ")"));
+    const double fprev = rep.residual_history[rep.residual_history.size() - 2];
+    if (k >= opt.contraction_from && fn > target && fn > opt.max_contraction * fprev)
+      return fail(internal::concat("not contracting at iterate ", k, ": ||F|| = ", fn, " from ", fprev, " (ratio ",
+                                   fn / fprev, " > max_contraction ", opt.max_contraction, ")"));
   }
   rep.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   res.x = std::move(x);
