@@ -22,6 +22,9 @@
 //   --contact-smoothing d       contact-switch smoothing of the reduced-model part (default 0.05;
 //                               0 = exact Osher switch, whose residual is not C2 at the equilibrium)
 //   --quick                     coarse grid, M = 0.5 .. 0.8 step 0.1, shorter time marching
+//   --tracer-max-step s         largest arclength step of the hand-over, in its metric (default 1)
+//   --tracer-dw-tol t           GMRES tolerance of dw0/dnu in the arclength hand-over
+//                               (symmetric_hopf_curve_options::derivative_tolerance)
 //   --verbose                   a line per Hopf Newton iteration (and per arclength corrector iteration)
 //
 // Outputs under out_dir (default out/aerofoil_flutter):
@@ -126,6 +129,9 @@ bool start_reorthogonalize = false;  // --start-gram-schmidt once|twice: ... of 
 /// and the last, most expensive Newton step (GMRES to 1e-5) is saved. The very coarse check
 /// and the reduced model keep 1e-10.
 double boundary_tolerance = 1e-7;
+double tracer_max_step = 0;  // --tracer-max-step: hopf_curve_options::max_step of the hand-over (0: 1.0)
+double tracer_derivative_tolerance = 0;  // --tracer-dw-tol: symmetric_hopf_curve_options::derivative_tolerance
+                                         // of the hand-over (0: aerofoil_tracer_options' value)
 
 hopf_options hopf_opts(const std::string& label, double tolerance = 1e-10) {
   hopf_options ho;
@@ -275,7 +281,9 @@ constexpr double same_mode_cosine = 0.9;
 boundary arclength_bridge(const structural_case& c, const grid_level& g, const std::vector<double>& machs,
                           const boundary_point& from, int fill) {
   const double m_max = machs.back();
-  tracer_options to = aerofoil_tracer_options(g, c, from.mach, m_max, fill);
+  tracer_options to = tracer_max_step > 0
+                          ? aerofoil_tracer_options(g, c, from.mach, m_max, fill, 0.5, 0.01, 0.05, tracer_max_step)
+                          : aerofoil_tracer_options(g, c, from.mach, m_max, fill);
   hopf_curve_options& ho = to.curve;
   ho.nu_targets.clear();
   for (double m : machs)
@@ -285,6 +293,7 @@ boundary arclength_bridge(const structural_case& c, const grid_level& g, const s
   ho.start.newton.abs_tolerance = boundary_tolerance;
   ho.newton.abs_tolerance = boundary_tolerance;
   if (verbose_newton) ho.newton.observer = newton_progress("      corrector");
+  if (tracer_derivative_tolerance > 0) to.symmetric.derivative_tolerance = tracer_derivative_tolerance;
   double m_hi = from.mach;
   const double fold_tolerance = 0.005;
   boundary out;
@@ -338,9 +347,16 @@ boundary arclength_bridge(const structural_case& c, const grid_level& g, const s
     std::printf("    arclength failed: %s\n", e.what());
     return out;
   }
+  long gmres_hopf = 0, gmres_steady = 0;
+  for (const auto& st : r.stats) {
+    gmres_hopf += st.linear_iterations;
+    gmres_steady += st.steady_linear_iterations;
+  }
   std::printf("    arclength: %zu points (%zu beyond M = %.5f), %d failed correctors, %d steps at fixed M or Ubar, "
-              "%d nested steady solves, %.2f s; stop: %s\n",
-              r.points.size(), out.size(), from.mach, r.failed_correctors, r.kink_steps, r.steady_solves, r.seconds,
+              "%d nested steady solves (%.2f s with dw0/dnu), GMRES %ld Hopf + %ld steady and dw0/dnu, %.2f s; "
+              "stop: %s\n",
+              r.points.size(), out.size(), from.mach, r.failed_correctors, r.kink_steps, r.steady_solves,
+              r.steady_seconds, gmres_hopf, gmres_steady, r.seconds,
               r.stop == hopf_curve_stop::requested ? why.c_str() : r.stop_reason.c_str());
   return out;
 }
@@ -987,6 +1003,12 @@ int main(int argc, char** argv) {
       } else if (a == "--start-tolerance") {
         start_tolerance = std::stod(next());
         require(start_tolerance > 0 && start_tolerance < 1, "--start-tolerance must be in (0, 1)");
+      } else if (a == "--tracer-max-step") {
+        tracer_max_step = std::stod(next());
+        require(tracer_max_step > 0, "--tracer-max-step must be > 0");
+      } else if (a == "--tracer-dw-tol") {
+        tracer_derivative_tolerance = std::stod(next());
+        require(tracer_derivative_tolerance > 0 && tracer_derivative_tolerance < 1, "--tracer-dw-tol must be in (0, 1)");
       } else if (a == "--verbose") {
         verbose_newton = true;
       } else if (a == "--quick") {

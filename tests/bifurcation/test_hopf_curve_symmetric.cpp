@@ -284,6 +284,9 @@ TEST(hopf_curve_symmetric, refuses_bad_input_and_reports_step_failure) {
   so = {};
   so.steady.abs_tolerance = 0;
   EXPECT_THROW(trace_symmetric_hopf_curve<2>(family, 0.6, start, o, 1, so), input_error);
+  so = {};
+  so.derivative_tolerance = 1.0;
+  EXPECT_THROW(trace_symmetric_hopf_curve<2>(family, 0.6, start, o, 1, so), input_error);
 
   // A family that cannot be built beyond nu = 0.7 (a steady solve failing past some Mach number)
   auto limited = [](double nu) {

@@ -31,7 +31,7 @@
 // failed corrector, so the step is halved. Solved equilibria are cached by nu (the corrector
 // revisits the same nu in the residual and the Jacobian).
 //     dw0/dnu = -f_w^{-1} f_nu,   f_nu = (f(w0, mu; nu + h) - f(w0, mu; nu - h)) / 2h
-// (GMRES with the same preconditioner, relative tolerance tangent_tolerance), once per nu.
+// (GMRES with the same preconditioner, relative tolerance derivative_tolerance), once per nu.
 //
 // Jacobian of G (never needed exactly: it sets the convergence rate only):
 //     J = [ A         omega I   A_mu p_r   G_nu,r   p_i
@@ -153,7 +153,11 @@ struct symmetric_hopf_curve_options {
   }();
   bool adaptive_tolerance = true;   ///< inexact-Newton forcing (file comment)
   double eta_max = 1e-2;
-  double tangent_tolerance = 1e-8;  ///< relative GMRES tolerance of tangents and dw0/dnu
+  double tangent_tolerance = 1e-8;  ///< relative GMRES tolerance of the exact tangents
+  /// Relative GMRES tolerance of dw0/dnu. It enters only the Jacobian column G_nu (the
+  /// convergence rate, not the converged point) and the warm start of the next steady solve, so
+  /// it need not be tight: an error eta in it perturbs Newton's contraction by about eta.
+  double derivative_tolerance = 1e-8;
   newton_options steady = [] {
     newton_options o;
     o.abs_tolerance = 1e-11;  ///< on ||f(w, mu; nu)||_2
@@ -207,8 +211,10 @@ symmetric_hopf_curve_result trace_symmetric_hopf_curve(const F& family, double n
   require(nu0 >= opt.nu_min && nu0 <= opt.nu_max, lab, ": nu0 = ", nu0, " outside [nu_min, nu_max]");
   require(direction == 1 || direction == -1, lab, ": direction must be +1 or -1");
   require(sopt.fill_level >= 0, lab, ": fill level ", sopt.fill_level, " < 0");
-  require(sopt.eta_max > 0 && sopt.eta_max < 1 && sopt.tangent_tolerance > 0 && sopt.tangent_tolerance < 1, lab,
-          ": GMRES tolerances must lie in (0, 1) (eta_max ", sopt.eta_max, ", tangent ", sopt.tangent_tolerance, ")");
+  require(sopt.eta_max > 0 && sopt.eta_max < 1 && sopt.tangent_tolerance > 0 && sopt.tangent_tolerance < 1 &&
+              sopt.derivative_tolerance > 0 && sopt.derivative_tolerance < 1,
+          lab, ": GMRES tolerances must lie in (0, 1) (eta_max ", sopt.eta_max, ", tangent ", sopt.tangent_tolerance,
+          ", dw0/dnu ", sopt.derivative_tolerance, ")");
   require(sopt.steady.abs_tolerance > 0 && sopt.steady.max_iterations >= 1, lab,
           ": nested steady Newton needs abs_tolerance > 0 and max_iterations >= 1");
   require(std::isfinite(start.mu) && std::isfinite(start.omega), lab, ": start mu or omega is not finite");
@@ -348,7 +354,7 @@ symmetric_hopf_curve_result trace_symmetric_hopf_curve(const F& family, double n
     const S& sm = system_at(minus, e.nu - h);
     const vec<double> f_nu = (vec<double>(sp.residual(e.w, mu)) - vec<double>(sm.residual(e.w, mu))) / (2 * h);
     rilu.compute(lb);
-    e.dw = gmres_real(a, vec<double>(-f_nu), sopt.tangent_tolerance,
+    e.dw = gmres_real(a, vec<double>(-f_nu), sopt.derivative_tolerance,
                       internal::concat(lab, ": dw0/dnu at nu = ", e.nu, ", GMRES"));
     acc.steady_seconds += std::chrono::duration<double>(clock::now() - t0).count();
   };
