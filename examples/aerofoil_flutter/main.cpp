@@ -25,17 +25,22 @@
 //   --tracer-max-step s         largest arclength step of the hand-over, in its metric (default 1)
 //   --tracer-dw-tol t           GMRES tolerance of dw0/dnu in the arclength hand-over
 //                               (symmetric_hopf_curve_options::derivative_tolerance)
+//   --crossing-medium           run the crossing check (every imaginary-axis crossing at the jumps
+//                               and last points) on the medium grid too, not only the coarse one
 //   --verbose                   a line per Hopf Newton iteration (and per arclength corrector iteration)
 //
 // Outputs under out_dir (default out/aerofoil_flutter):
 //   flutter_point_very_coarse.txt, spectra.csv (ubar,re,im)     very coarse, light, M = 0.5
 //   boundary_<case>_very_coarse.csv, jump_check.csv             boundary jumps checked by dense spectra
+//   crossing_check.csv (case,grid,mach,ubar_star,omega_star,ubar,omega)   every imaginary-axis crossing at
+//                               the jumps and last points of the coarse/medium boundaries (Schur complement)
 //   boundary_<case>_<grid>.csv  mach,ubar,omega,newton_iterations,linear_iterations,hopf_seconds,steady_seconds
 //   verification.csv, history_<case>_M<mach>_<factor>.csv       time marching at 0.97 / 1.03 Ubar*
 //   costs.csv                                                   cost ratios to the steady solve
 //   reduced_coefficients.csv, reduced_damping.csv, reduced_lco.csv   reduced model (heavy case)
 //   reduced_envelope.csv        amplitude-dependent growth rate: time marching vs reduced model
 // plot.py in this folder turns them into PNGs.
+#include <aerohopf/bifurcation/axis_crossings.hpp>
 #include <aerohopf/bifurcation/hopf.hpp>
 #include <aerohopf/bifurcation/hopf_bordered.hpp>
 #include <aerohopf/bifurcation/hopf_curve.hpp>
@@ -88,6 +93,7 @@ struct options {
   int fill = 2;
   double contact_smoothing = 0.05;  // of the reduced model's discretisation (osher_flux.hpp)
   bool spectra = true, boundaries = true, jump_check = true, verify = true, reduced = true, quick = false;
+  bool crossing_medium = false;  // --crossing-medium: the crossing check on the medium grid too (~1 s per LU)
   grid_level verify_grid = level_named("medium");
 };
 
@@ -579,6 +585,16 @@ std::map<std::string, boundary> boundaries_part(const options& o) {
 // 0.995 / 1.005 Ubar*. The point is the lowest crossing (within the scan) iff max Re < 0 below
 // it and > 0 just above it. Writes jump_check.csv (case,mach,ubar_star,ubar,max_re,im_at_max).
 
+/// The points of a boundary whose lowest-crossing property is checked: the jumps (structural
+/// cosine < 0.9 to the previous point) and the last point.
+std::vector<std::pair<std::size_t, const char*>> check_points(const boundary& b) {
+  std::vector<std::pair<std::size_t, const char*>> at;
+  for (std::size_t k = 1; k < b.size(); ++k)
+    if (structural_cosine(b[k - 1].point.p, b[k].point.p) < same_mode_cosine) at.emplace_back(k, "jump");
+  if (!b.empty() && (at.empty() || at.back().first != b.size() - 1)) at.emplace_back(b.size() - 1, "last point");
+  return at;
+}
+
 void jump_check_part(const options& o, const std::map<std::string, boundary>& all) {
   const grid_level g = level_named("very_coarse");
   const auto machs = mach_list(o);
@@ -597,11 +613,7 @@ void jump_check_part(const options& o, const std::map<std::string, boundary>& al
                       "mach,ubar,omega,newton_iterations,linear_iterations,hopf_seconds,steady_seconds");
       return natural_boundary(c, g, machs, nullptr, 0, o.fill, bcsv);
     }();
-    std::vector<std::pair<std::size_t, const char*>> at;  // jumps (structural cosine < 0.9) and the last point
-    for (std::size_t k = 1; k < b.size(); ++k)
-      if (structural_cosine(b[k - 1].point.p, b[k].point.p) < same_mode_cosine) at.emplace_back(k, "jump");
-    if (!b.empty() && (at.empty() || at.back().first != b.size() - 1)) at.emplace_back(b.size() - 1, "last point");
-    for (const auto& [k, what] : at) {
+    for (const auto& [k, what] : check_points(b)) {
       const auto& p = b[k];
       const auto s = make_system(g, p.mach, c.mu_s);
       const vec<double>& w0 = p.point.w;  // the steady flow at this Mach number (symmetric Hopf point)
@@ -635,6 +647,59 @@ void jump_check_part(const options& o, const std::map<std::string, boundary>& al
     }
   }
   std::printf("  jump check: %d points checked, %d failed\n", checked, failed);
+}
+
+/// The same question on the coarse and medium grids, where a dense spectrum is out of reach:
+/// J(Ubar) = A0 + B / Ubar^2 with B in the structural block (the equilibrium does not depend on
+/// Ubar), so imaginary_axis_crossings (bifurcation/axis_crossings.hpp: Schur complement onto the
+/// four structural unknowns, one complex sparse LU of i omega I - A_ff per frequency) lists
+/// EVERY crossing of the imaginary axis with omega in [0.05, 6 omega*]. That band holds the
+/// crossings down to Ubar = 0.2 Ubar* (the structural frequencies in c/U time scale with
+/// 1/Ubar). PASS: the lowest crossing above 0.2 Ubar* is the boundary point itself.
+void crossing_check_part(const options& o, const std::map<std::string, boundary>& all) {
+  csv_writer out(o.out / "crossing_check.csv", "case,grid,mach,ubar_star,omega_star,ubar,omega");
+  int checked = 0, failed = 0;
+  for (const auto& g : o.grids) {
+    if (g.name == "very_coarse" || (g.name == "medium" && !o.crossing_medium)) continue;
+    for (const auto& c : o.cases) {
+      const auto known = all.find(c.name + "_" + g.name);
+      if (known == all.end()) continue;
+      std::cout << "\n=== crossing check: " << c.name << " case, " << g.name
+                << " grid (all imaginary-axis crossings by the structural Schur complement) ===\n";
+      const boundary& b = known->second;
+      for (const auto& [k, what] : check_points(b)) {
+        const auto& p = b[k];
+        const auto t0 = clk::now();
+        const auto s = make_system(g, p.mach, c.mu_s);
+        const vec<double>& w0 = p.point.w;
+        const double u1 = p.ubar, u2 = 0.5 * p.ubar;
+        const affine_split sp =
+            split_affine(s.jacobian(w0, u1), 1 / (u1 * u1), s.jacobian(w0, u2), 1 / (u2 * u2), 4, "crossing check");
+        axis_crossing_options ao;
+        ao.omega_min = 0.05;
+        ao.omega_max = 6 * p.omega;
+        ao.samples = std::max(100, static_cast<int>(std::ceil((ao.omega_max - ao.omega_min) / 0.02)));
+        ao.context = c.name + " " + g.name + " crossing check";
+        const axis_crossing_result r = imaginary_axis_crossings(sp.a0, sp.b_ss, ao);
+        const axis_crossing* lowest = nullptr;
+        for (const auto& x : r.crossings) {
+          if (!(x.q > 0)) continue;
+          const double u = 1 / std::sqrt(x.q);
+          out.row({c.name, g.name, p.mach, p.ubar, p.omega, u, x.omega});
+          if (u >= 0.2 * p.ubar && (!lowest || x.q > lowest->q)) lowest = &x;
+        }
+        const double ul = lowest ? 1 / std::sqrt(lowest->q) : NAN;
+        const bool ok = lowest && std::abs(ul - p.ubar) <= 1e-5 * p.ubar && std::abs(lowest->omega - p.omega) <= 1e-4;
+        std::printf("    M = %.4f (%s)  Ubar* = %.5f omega* = %.4f: %zu crossings in omega 0.05 .. %.2f (%d LU), lowest "
+                    "Ubar = %.5f at omega = %.4f -> %s  (%.1f s)\n",
+                    p.mach, what, p.ubar, p.omega, r.crossings.size(), ao.omega_max, r.factorisations, ul,
+                    lowest ? lowest->omega : NAN, ok ? "lowest crossing (PASS)" : "FAIL", seconds_since(t0));
+        ++checked;
+        failed += ok ? 0 : 1;
+      }
+    }
+  }
+  std::printf("  crossing check: %d points checked, %d failed\n", checked, failed);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -1009,6 +1074,8 @@ int main(int argc, char** argv) {
       } else if (a == "--tracer-dw-tol") {
         tracer_derivative_tolerance = std::stod(next());
         require(tracer_derivative_tolerance > 0 && tracer_derivative_tolerance < 1, "--tracer-dw-tol must be in (0, 1)");
+      } else if (a == "--crossing-medium") {
+        o.crossing_medium = true;
       } else if (a == "--verbose") {
         verbose_newton = true;
       } else if (a == "--quick") {
@@ -1032,6 +1099,7 @@ int main(int argc, char** argv) {
     std::map<std::string, boundary> all;
     if (o.boundaries) all = boundaries_part(o);
     if (o.jump_check) jump_check_part(o, all);
+    if (o.jump_check && o.boundaries) crossing_check_part(o, all);
     std::vector<double> march_costs;
     if (o.verify) verification_part(o, all, march_costs);
     if (o.reduced) reduced_part(o, all);

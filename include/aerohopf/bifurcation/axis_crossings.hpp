@@ -1,0 +1,269 @@
+#pragma once
+// All crossings of the imaginary axis by eigenvalues of A(q) = A0 + q B over a frequency band,
+// when the parameter enters only a small trailing block: B is zero outside its last m rows and
+// columns (the aerofoil: q = 1/Ubar^2 enters only the structural stiffness, spec 05). It needs
+// sparse LU solves with the large block and no eigen-decomposition of A, so it checks on grids
+// where a dense spectrum is out of reach that a Hopf point found by Newton or continuation is the
+// LOWEST crossing (the flutter boundary) and not a later one.
+//
+// Split the unknowns into f (first n - m) and s (last m). With X(w) = i w I - A_ff,
+//     det(i w I - A(q)) = det X(w) det(E(w) - q B_ss),
+//     E(w) = i w I - A_ss - A_sf X(w)^{-1} A_fs         (the m x m Schur complement),
+// so, where X(w) is regular, i w is an eigenvalue of A(q) iff det(E(w) - q B_ss) = 0: q is the
+// reciprocal of a nonzero eigenvalue of E(w)^{-1} B_ss (rank B_ss = r such roots q_k(w)). A
+// crossing at a REAL q is a zero of Im q_k(w) along a root branch. The band [omega_min,
+// omega_max] is sampled (one complex sparse LU of X(w) per sample: A_ff does not depend on q),
+// the r roots are matched from sample to sample (nearest permutation), and every sign change of
+// Im q_k is refined by the Illinois (modified regula falsi) iteration on w until the bracket is
+// shorter than omega_tolerance. A sign change through a pole (|q| -> infinity) is not a
+// crossing: a refined root must have |Im q| <= real_tolerance (1 + |q|), else it is dropped and
+// counted in `rejected`. Not covered: w = 0 (static divergence: real q with det(E(0) - q B_ss)
+// = 0, see `divergence_roots`) and crossings whose frequency lies outside the band or between
+// two samples twice (two crossings of one branch closer than the sample spacing).
+#include <Eigen/Dense>
+#include <Eigen/Sparse>
+
+#include <algorithm>
+#include <cmath>
+#include <complex>
+#include <numeric>
+#include <string>
+#include <vector>
+
+#include "../error.hpp"
+#include "../linalg/direct.hpp"
+
+namespace aerohopf {
+
+struct axis_crossing {
+  double q = 0;      ///< parameter value (real) at which the eigenvalue i omega lies on the axis
+  double omega = 0;  ///< frequency of the crossing (> 0; its conjugate crosses at -omega)
+  int branch = 0;    ///< root branch k of det(E(w) - q B_ss) = 0
+  double residual = 0;  ///< |Im q| at the refined frequency
+};
+
+struct axis_crossing_options {
+  double omega_min = 1e-3;
+  double omega_max = 2.0;
+  int samples = 400;               ///< equally spaced frequencies in [omega_min, omega_max]
+  double omega_tolerance = 1e-10;  ///< bracket length at which the refinement stops
+  int max_refinements = 80;
+  double real_tolerance = 1e-6;    ///< |Im q| <= real_tolerance (1 + |q|) for an accepted root
+  std::string context = "imaginary-axis crossings";
+};
+
+struct axis_crossing_result {
+  std::vector<axis_crossing> crossings;  ///< sorted by q, largest first
+  std::vector<std::complex<double>> divergence_roots;  ///< the roots q at omega = 0
+  int rank = 0;                          ///< number of finite roots (rank of B_ss)
+  int factorisations = 0;                ///< complex sparse LU factorisations of X(w)
+  int rejected = 0;                      ///< sign changes of Im q through a pole
+};
+
+namespace internal {
+/// The Schur-complement roots q_k(w) of det(E(w) - q B_ss) = 0 at one frequency (w = 0 allowed).
+class axis_crossing_roots {
+ public:
+  using cplx = std::complex<double>;
+  axis_crossing_roots(const Eigen::SparseMatrix<double>& a0, const Eigen::MatrixXd& b_ss, const std::string& context)
+      : m_(b_ss.rows()), nf_(a0.rows() - b_ss.rows()), b_(b_ss), lu_(context + ": sparse LU of i omega I - A_ff") {
+    require(a0.rows() == a0.cols(), context, ": A0 is ", a0.rows(), "x", a0.cols(), ", not square");
+    require(b_ss.rows() == b_ss.cols() && m_ >= 1 && nf_ >= 1, context, ": B_ss is ", b_ss.rows(), "x", b_ss.cols(),
+            " for A0 of size ", a0.rows());
+    require(b_ss.allFinite(), context, ": B_ss has non-finite entries");
+    std::vector<Eigen::Triplet<double>> tf;
+    a_fs_ = Eigen::MatrixXd::Zero(nf_, m_);
+    a_sf_ = Eigen::MatrixXd::Zero(m_, nf_);
+    a_ss_ = Eigen::MatrixXd::Zero(m_, m_);
+    for (int k = 0; k < a0.outerSize(); ++k)
+      for (Eigen::SparseMatrix<double>::InnerIterator it(a0, k); it; ++it) {
+        const Eigen::Index i = it.row(), j = it.col();
+        require(std::isfinite(it.value()), context, ": A0(", i, ", ", j, ") is not finite");
+        if (i < nf_ && j < nf_)
+          tf.emplace_back(int(i), int(j), -it.value());
+        else if (i < nf_)
+          a_fs_(i, j - nf_) = it.value();
+        else if (j < nf_)
+          a_sf_(i - nf_, j) = it.value();
+        else
+          a_ss_(i - nf_, j - nf_) = it.value();
+      }
+    for (Eigen::Index i = 0; i < nf_; ++i) tf.emplace_back(int(i), int(i), 0.0);  // the diagonal, for i w
+    minus_aff_.resize(nf_, nf_);
+    minus_aff_.setFromTriplets(tf.begin(), tf.end());
+    minus_aff_.makeCompressed();
+    // rank of B_ss: its number of nonzero singular values (relative 1e-12)
+    const Eigen::JacobiSVD<Eigen::MatrixXd> svd(b_ss);
+    const auto& sv = svd.singularValues();
+    rank_ = 0;
+    for (Eigen::Index i = 0; i < sv.size(); ++i)
+      if (sv[i] > 1e-12 * sv[0]) ++rank_;
+    require(rank_ >= 1, context, ": B_ss is zero: the parameter does not enter A");
+  }
+  int rank() const { return rank_; }
+  int factorisations() const { return factorisations_; }
+
+  /// The rank() roots q_k at frequency w, in no particular order.
+  std::vector<cplx> at(double w) {
+    Eigen::SparseMatrix<cplx> x = minus_aff_.cast<cplx>();
+    for (Eigen::Index i = 0; i < nf_; ++i) x.coeffRef(i, i) += cplx(0.0, w);
+    lu_.compute(x);
+    ++factorisations_;
+    const Eigen::MatrixXcd y = lu_.solve(Eigen::MatrixXcd(a_fs_.cast<cplx>()));
+    Eigen::MatrixXcd e = -a_ss_.cast<cplx>() - a_sf_.cast<cplx>() * y;
+    e.diagonal().array() += cplx(0.0, w);
+    const Eigen::PartialPivLU<Eigen::MatrixXcd> elu(e);
+    const Eigen::MatrixXcd mb = elu.solve(Eigen::MatrixXcd(b_.cast<cplx>()));
+    const Eigen::ComplexEigenSolver<Eigen::MatrixXcd> es(mb, false);
+    std::vector<cplx> nu(es.eigenvalues().data(), es.eigenvalues().data() + m_);
+    std::sort(nu.begin(), nu.end(), [](cplx a, cplx b) { return std::abs(a) > std::abs(b); });
+    std::vector<cplx> q;
+    for (int k = 0; k < rank_; ++k) q.push_back(std::abs(nu[k]) > 0 ? 1.0 / nu[k] : cplx(INFINITY, 0.0));
+    return q;
+  }
+
+ private:
+  Eigen::Index m_, nf_;
+  Eigen::MatrixXd b_, a_fs_, a_sf_, a_ss_;
+  Eigen::SparseMatrix<double> minus_aff_;
+  direct_solver<Eigen::SparseMatrix<cplx>> lu_;
+  int rank_ = 0, factorisations_ = 0;
+};
+
+/// The permutation of `now` nearest to `before` (sum of distances; r <= 6 by brute force, else greedy).
+inline std::vector<std::complex<double>> match_roots(const std::vector<std::complex<double>>& before,
+                                                     std::vector<std::complex<double>> now) {
+  const std::size_t r = now.size();
+  std::vector<std::size_t> perm(r), best;
+  std::iota(perm.begin(), perm.end(), 0);
+  double best_cost = INFINITY;
+  if (r <= 6) {
+    do {
+      double c = 0;
+      for (std::size_t k = 0; k < r; ++k) c += std::abs(now[perm[k]] - before[k]);
+      if (c < best_cost) {
+        best_cost = c;
+        best = perm;
+      }
+    } while (std::next_permutation(perm.begin(), perm.end()));
+  } else {
+    std::vector<bool> used(r, false);
+    for (std::size_t k = 0; k < r; ++k) {
+      std::size_t j_best = 0;
+      double d_best = INFINITY;
+      for (std::size_t j = 0; j < r; ++j)
+        if (!used[j] && std::abs(now[j] - before[k]) < d_best) {
+          d_best = std::abs(now[j] - before[k]);
+          j_best = j;
+        }
+      used[j_best] = true;
+      best.push_back(j_best);
+    }
+  }
+  std::vector<std::complex<double>> out(r);
+  for (std::size_t k = 0; k < r; ++k) out[k] = now[best[k]];
+  return out;
+}
+}  // namespace internal
+
+/// A(q) = A0 + q B from the matrices j1 = A(q1) and j2 = A(q2), q1 != q2, of a matrix affine in q
+/// (the aerofoil: q = 1/Ubar^2); throws input_error if j1 - j2 has an entry outside the trailing
+/// m x m block. Affinity itself is the caller's to know (or to check with a third matrix).
+struct affine_split {
+  Eigen::SparseMatrix<double> a0;  ///< A(0)
+  Eigen::MatrixXd b_ss;            ///< the trailing m x m block of dA/dq
+};
+inline affine_split split_affine(const Eigen::SparseMatrix<double>& j1, double q1, const Eigen::SparseMatrix<double>& j2,
+                                 double q2, Eigen::Index m, const std::string& context = "split_affine") {
+  require(j1.rows() == j1.cols() && j2.rows() == j1.rows() && j2.cols() == j1.cols(), context,
+          ": matrices of different sizes (", j1.rows(), "x", j1.cols(), ", ", j2.rows(), "x", j2.cols(), ")");
+  require(std::isfinite(q1) && std::isfinite(q2) && q1 != q2, context, ": need finite q1 != q2 (got ", q1, ", ", q2, ")");
+  const Eigen::Index n = j1.rows();
+  require(m >= 1 && m < n, context, ": trailing block size ", m, " for matrices of size ", n);
+  const Eigen::SparseMatrix<double> d = j1 - j2;
+  affine_split out;
+  out.b_ss = Eigen::MatrixXd::Zero(m, m);
+  for (int k = 0; k < d.outerSize(); ++k)
+    for (Eigen::SparseMatrix<double>::InnerIterator it(d, k); it; ++it) {
+      if (it.value() == 0) continue;
+      require(it.row() >= n - m && it.col() >= n - m, context, ": the matrix depends on q at (", it.row(), ", ",
+              it.col(), "), outside the trailing ", m, " x ", m, " block");
+      out.b_ss(it.row() - (n - m), it.col() - (n - m)) = it.value() / (q1 - q2);
+    }
+  out.a0 = j1;
+  for (Eigen::Index i = 0; i < m; ++i)
+    for (Eigen::Index j = 0; j < m; ++j)
+      if (out.b_ss(i, j) != 0) out.a0.coeffRef(n - m + i, n - m + j) -= q1 * out.b_ss(i, j);
+  return out;
+}
+
+/// All crossings of the imaginary axis by eigenvalues of A0 + q B (B nonzero only in its trailing
+/// block b_ss) with frequency in [omega_min, omega_max] (file comment).
+inline axis_crossing_result imaginary_axis_crossings(const Eigen::SparseMatrix<double>& a0, const Eigen::MatrixXd& b_ss,
+                                                     const axis_crossing_options& opt = {}) {
+  const std::string& ctx = opt.context;
+  require(opt.omega_min > 0 && opt.omega_max > opt.omega_min && opt.samples >= 2, ctx,
+          ": need 0 < omega_min < omega_max and samples >= 2 (got ", opt.omega_min, ", ", opt.omega_max, ", ",
+          opt.samples, ")");
+  require(opt.omega_tolerance > 0 && opt.real_tolerance > 0 && opt.max_refinements >= 1, ctx,
+          ": tolerances must be > 0 and max_refinements >= 1");
+  internal::axis_crossing_roots roots(a0, b_ss, ctx);
+  axis_crossing_result res;
+  res.rank = roots.rank();
+  res.divergence_roots = roots.at(0.0);
+  const double dw = (opt.omega_max - opt.omega_min) / (opt.samples - 1);
+  double w_prev = opt.omega_min;
+  std::vector<std::complex<double>> q_prev = roots.at(w_prev);
+  for (int j = 1; j < opt.samples; ++j) {
+    const double w = opt.omega_min + j * dw;
+    const std::vector<std::complex<double>> q = internal::match_roots(q_prev, roots.at(w));
+    for (int k = 0; k < res.rank; ++k) {
+      const double fa0 = q_prev[k].imag(), fb0 = q[k].imag();
+      if (!(std::isfinite(fa0) && std::isfinite(fb0)) || fa0 * fb0 > 0 || (fa0 == 0 && fb0 == 0)) continue;
+      // Illinois on Im q_k(w); the branch is followed by the root nearest the interpolation of q_k
+      double a = w_prev, b = w, fa = fa0, fb = fb0;
+      std::complex<double> qa = q_prev[k], qb = q[k], qc = qa;
+      int side = 0;
+      for (int it = 0; it < opt.max_refinements && b - a > opt.omega_tolerance; ++it) {
+        double c = fa == fb ? 0.5 * (a + b) : (a * fb - b * fa) / (fb - fa);
+        if (!(c > a && c < b)) c = 0.5 * (a + b);
+        const double t = (c - a) / (b - a);
+        const std::complex<double> guess = qa + t * (qb - qa);
+        const std::vector<std::complex<double>> qs = roots.at(c);
+        qc = *std::min_element(qs.begin(), qs.end(), [&](auto u, auto v) { return std::abs(u - guess) < std::abs(v - guess); });
+        const double fc = qc.imag();
+        if (fc == 0) {
+          a = b = c;
+          qa = qb = qc;
+          break;
+        }
+        if (fc * fb < 0) {  // the zero lies in (c, b)
+          a = c;
+          fa = fc;
+          qa = qc;
+          if (side == -1) fb *= 0.5;  // b kept twice in a row: Illinois
+          side = -1;
+        } else {  // in (a, c)
+          b = c;
+          fb = fc;
+          qb = qc;
+          if (side == +1) fa *= 0.5;
+          side = +1;
+        }
+      }
+      const std::complex<double> qr = std::abs(qa.imag()) < std::abs(qb.imag()) ? qa : qb;
+      const double wr = std::abs(qa.imag()) < std::abs(qb.imag()) ? a : b;
+      if (std::isfinite(std::abs(qr)) && std::abs(qr.imag()) <= opt.real_tolerance * (1 + std::abs(qr)))
+        res.crossings.push_back({qr.real(), wr, k, std::abs(qr.imag())});
+      else
+        ++res.rejected;
+    }
+    q_prev = q;
+    w_prev = w;
+  }
+  std::sort(res.crossings.begin(), res.crossings.end(), [](const auto& u, const auto& v) { return u.q > v.q; });
+  res.factorisations = roots.factorisations();
+  return res;
+}
+
+}  // namespace aerohopf

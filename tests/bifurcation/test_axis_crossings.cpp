@@ -1,0 +1,159 @@
+// imaginary_axis_crossings against dense eigen-decompositions: on a small random system every
+// reported crossing is an eigenvalue on the axis, and every change of the number of unstable
+// eigenvalues along a fine q scan is explained by a reported crossing (or the divergence root);
+// on the aerofoil (very coarse grid, light case, M = 0.5) the lowest crossing is the Hopf point
+// of the augmented Newton solver.
+#include <gtest/gtest.h>
+
+#include <aerohopf/bifurcation/axis_crossings.hpp>
+#include <aerohopf/bifurcation/hopf.hpp>
+#include <aerohopf/flow/naca_cgrid.hpp>
+#include <aerohopf/flow/steady_solver.hpp>
+#include <aerohopf/models/aerofoil.hpp>
+
+#include <Eigen/Eigenvalues>
+
+#include <iostream>
+#include <random>
+
+using namespace aerohopf;
+
+namespace {
+// A stable "fluid" block of 40 unknowns coupled to two oscillators whose stiffnesses scale with q.
+struct toy {
+  Eigen::SparseMatrix<double> a0;
+  Eigen::MatrixXd b_ss;
+  Eigen::MatrixXd dense(double q) const {
+    Eigen::MatrixXd a = Eigen::MatrixXd(a0);
+    a.bottomRightCorner(4, 4) += q * b_ss;
+    return a;
+  }
+};
+toy make_toy() {
+  const int nf = 40, n = nf + 4;
+  std::mt19937 gen(7);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  Eigen::MatrixXd a = Eigen::MatrixXd::Zero(n, n);
+  for (int i = 0; i < nf; ++i) {
+    a(i, i) = -1.0 - 0.1 * i;
+    if (i + 1 < nf) a(i, i + 1) = 0.6 * u(gen);
+    if (i > 0) a(i, i - 1) = -0.6 * u(gen);
+  }
+  for (int i = 0; i < nf; ++i)
+    for (int j = 0; j < 4; ++j) {
+      a(i, nf + j) = 0.3 * u(gen);
+      a(nf + j, i) = 0.2 * u(gen);
+    }
+  // x1' = v1, v1' = -q x1 - 0.02 v1 + 0.3 x2, x2' = v2, v2' = -2 q x2 - 0.01 v2 - 0.2 x1
+  Eigen::Matrix4d ss;
+  ss << 0, 1, 0, 0, 0, -0.02, 0.3, 0, 0, 0, 0, 1, -0.2, 0, 0, -0.01;
+  a.bottomRightCorner(4, 4) += ss;
+  toy t;
+  t.a0 = a.sparseView();
+  t.b_ss = Eigen::Matrix4d::Zero();
+  t.b_ss(1, 0) = -1;
+  t.b_ss(3, 2) = -2;
+  return t;
+}
+int unstable_count(const Eigen::MatrixXd& a) {
+  const Eigen::EigenSolver<Eigen::MatrixXd> es(a, false);
+  int c = 0;
+  for (Eigen::Index i = 0; i < es.eigenvalues().size(); ++i) c += es.eigenvalues()[i].real() > 0;
+  return c;
+}
+}  // namespace
+
+TEST(axis_crossings, every_crossing_is_an_axis_eigenvalue_and_every_stability_change_a_crossing) {
+  const toy t = make_toy();
+  axis_crossing_options o;
+  o.omega_min = 1e-3;
+  o.omega_max = 6.0;
+  o.samples = 3000;
+  const axis_crossing_result r = imaginary_axis_crossings(t.a0, t.b_ss, o);
+  EXPECT_EQ(r.rank, 2);
+  ASSERT_FALSE(r.crossings.empty());
+  for (const auto& c : r.crossings) {
+    const Eigen::EigenSolver<Eigen::MatrixXd> es(t.dense(c.q), false);
+    double d = INFINITY;
+    for (Eigen::Index i = 0; i < es.eigenvalues().size(); ++i)
+      d = std::min(d, std::abs(es.eigenvalues()[i] - std::complex<double>(0, c.omega)));
+    EXPECT_LT(d, 1e-7) << "q " << c.q << " omega " << c.omega;
+  }
+  // along q in (0, 8]: the unstable count changes only at a reported crossing (2 eigenvalues:
+  // the pair) or a divergence root (1 real eigenvalue)
+  std::vector<double> events;
+  for (const auto& c : r.crossings)
+    if (c.q > 0 && c.q < 8) events.push_back(c.q);
+  for (const auto& d : r.divergence_roots)
+    if (std::abs(d.imag()) < 1e-9 && d.real() > 0 && d.real() < 8) events.push_back(d.real());
+  int explained = 0, changes = 0;
+  const int nq = 800;
+  int prev = unstable_count(t.dense(0.01));
+  for (int j = 1; j <= nq; ++j) {
+    const double q0 = 0.01 + (j - 1) * (8.0 - 0.01) / nq, q1 = 0.01 + j * (8.0 - 0.01) / nq;
+    const int now = unstable_count(t.dense(q1));
+    if (now != prev) {
+      ++changes;
+      bool found = false;
+      for (double e : events) found = found || (e > q0 - 1e-9 && e < q1 + 1e-9);
+      EXPECT_TRUE(found) << "the unstable count changes from " << prev << " to " << now << " between q = " << q0
+                         << " and " << q1 << " without a reported crossing";
+      explained += found;
+    }
+    prev = now;
+  }
+  std::cout << "toy: " << r.crossings.size() << " crossings (" << r.rejected << " rejected), " << changes
+            << " stability changes on the q scan, " << explained << " explained, " << r.factorisations
+            << " factorisations\n";
+  EXPECT_GE(changes, 1);
+
+  axis_crossing_options bad = o;
+  bad.omega_max = 0;
+  EXPECT_THROW(imaginary_axis_crossings(t.a0, t.b_ss, bad), input_error);
+  EXPECT_THROW(imaginary_axis_crossings(t.a0, Eigen::MatrixXd::Zero(4, 4), o), input_error);
+  EXPECT_THROW(imaginary_axis_crossings(t.a0, Eigen::MatrixXd::Identity(50, 50), o), input_error);
+}
+
+// The aerofoil: q = 1/Ubar^2 enters only the structural stiffness, so J(Ubar) = A0 + q B with B in
+// the structural 4 x 4 block. The largest crossing q (lowest Ubar) over the band is the Hopf
+// point of the augmented Newton solver (the dense-spectrum test of test_aerofoil_hopf checks
+// that point against all eigenvalues).
+TEST(axis_crossings, aerofoil_lowest_crossing_is_the_hopf_point) {
+  structure::pitch_plunge_parameters p;
+  p.mu_s = 10;
+  const models::aerofoil_system s(flow::euler_model<2>(flow::coarsen(flow::naca_cgrid(), 8), {.mach = 0.5, .alpha_rad = 0.0}),
+                                  structure::pitch_plunge(p));
+  const vec<double> w = s.steady_equilibrium();
+  const double u1 = 1.5, u2 = 2.5, q1 = 1 / (u1 * u1), q2 = 1 / (u2 * u2);
+  const Eigen::SparseMatrix<double> j1 = s.jacobian(w, u1), j2 = s.jacobian(w, u2);
+  const affine_split sp = split_affine(j1, q1, j2, q2, 4, "aerofoil");
+  const Eigen::SparseMatrix<double>& a0 = sp.a0;
+  const Eigen::MatrixXd& b = sp.b_ss;
+  // a change outside the structural block is refused
+  Eigen::SparseMatrix<double> j2x = j2;
+  j2x.coeffRef(0, 0) += 1.0;
+  EXPECT_THROW(split_affine(j1, q1, j2x, q2, 4), input_error);
+  // affine in q: the third Jacobian is reproduced
+  const double u3 = 1.9, q3 = 1 / (u3 * u3);
+  Eigen::MatrixXd j3 = Eigen::MatrixXd(s.jacobian(w, u3)), a3 = Eigen::MatrixXd(a0);
+  a3.bottomRightCorner(4, 4) += q3 * b;
+  EXPECT_LT((j3 - a3).norm(), 1e-12 * j3.norm());
+
+  axis_crossing_options o;
+  o.omega_min = 0.05;
+  o.omega_max = 3.0;
+  o.samples = 120;
+  const axis_crossing_result r = imaginary_axis_crossings(a0, b, o);
+  ASSERT_FALSE(r.crossings.empty());
+  const axis_crossing& lowest = r.crossings.front();  // largest q
+  const double ubar = 1 / std::sqrt(lowest.q);
+
+  hopf_options ho;
+  ho.symmetric = true;
+  const hopf_result h = solve_hopf(s, hopf_start(s, w, 1.75, 0.6), ho);
+  std::cout << "aerofoil: " << r.crossings.size() << " crossings, lowest Ubar = " << ubar << " omega = " << lowest.omega
+            << " (Hopf solver: " << h.point.mu << ", " << h.point.omega << "), rank " << r.rank << ", "
+            << r.factorisations << " factorisations\n";
+  EXPECT_NEAR(ubar, h.point.mu, 1e-7);
+  EXPECT_NEAR(lowest.omega, h.point.omega, 1e-7);
+}
