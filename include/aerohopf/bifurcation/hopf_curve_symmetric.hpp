@@ -466,13 +466,10 @@ symmetric_hopf_curve_result trace_symmetric_hopf_curve(const F& family, double n
     try {
       newton_result nr = newton_iterate(
           [&](const vec<double>& x) {
-            double d2 = 0;
-            for (int j = 0; j < 3; ++j)
-              if (sig[j] > 0) d2 += (yv(x, j) - yv(x0, j)) * (yv(x, j) - yv(x0, j)) / (sig[j] * sig[j]);
-            if (!(std::sqrt(d2) <= radius))
+            const double d = ydist(x, x0);
+            if (!(d <= radius))
               throw convergence_error(internal::concat(lab, " corrector: iterate at nu = ", x[inu], ", mu = ", x[imu],
-                                                       " lies ", std::sqrt(d2), " from the prediction (more than ",
-                                                       radius, ")"));
+                                                       " lies ", d, " from the prediction (more than ", radius, ")"));
             return residual(x, s, c, value);
           },
           [&](const vec<double>& x, const vec<double>& f, int it) {
