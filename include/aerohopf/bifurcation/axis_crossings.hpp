@@ -89,9 +89,26 @@ class axis_crossing_roots {
           a_ss_(i - nf_, j - nf_) = it.value();
       }
     for (Eigen::Index i = 0; i < nf_; ++i) tf.emplace_back(int(i), int(i), 0.0);  // the diagonal, for i w
-    minus_aff_.resize(nf_, nf_);
-    minus_aff_.setFromTriplets(tf.begin(), tf.end());
-    minus_aff_.makeCompressed();
+    Eigen::SparseMatrix<double> minus_aff(nf_, nf_);
+    minus_aff.setFromTriplets(tf.begin(), tf.end());
+    minus_aff.makeCompressed();
+    // X(w) = i w I - A_ff is formed once; per frequency only its diagonal values change
+    x_ = minus_aff.cast<cplx>();
+    x_.makeCompressed();
+    diag_.resize(nf_);
+    diag0_.resize(nf_);
+    for (Eigen::Index i = 0; i < nf_; ++i) {
+      const auto* first = x_.innerIndexPtr() + x_.outerIndexPtr()[i];
+      const auto* last = x_.innerIndexPtr() + x_.outerIndexPtr()[i + 1];
+      const auto* at = std::lower_bound(first, last, i);
+      require(at != last && *at == i, context, ": no diagonal entry in column ", i, " of A_ff");
+      diag_[i] = at - x_.innerIndexPtr();
+      diag0_[i] = x_.valuePtr()[diag_[i]];
+    }
+    a_fs_c_ = a_fs_.cast<cplx>();
+    a_sf_c_ = a_sf_.cast<cplx>();
+    a_ss_c_ = a_ss_.cast<cplx>();
+    b_c_ = b_.cast<cplx>();
     // rank of B_ss: its number of nonzero singular values (relative 1e-12)
     const Eigen::JacobiSVD<Eigen::MatrixXd> svd(b_ss);
     const auto& sv = svd.singularValues();
@@ -105,15 +122,14 @@ class axis_crossing_roots {
 
   /// The rank() roots q_k at frequency w, in no particular order.
   std::vector<cplx> at(double w) {
-    Eigen::SparseMatrix<cplx> x = minus_aff_.cast<cplx>();
-    for (Eigen::Index i = 0; i < nf_; ++i) x.coeffRef(i, i) += cplx(0.0, w);
-    lu_.compute(x);
+    for (Eigen::Index i = 0; i < nf_; ++i) x_.valuePtr()[diag_[i]] = diag0_[i] + cplx(0.0, w);
+    lu_.compute(x_);
     ++factorisations_;
-    const Eigen::MatrixXcd y = lu_.solve(Eigen::MatrixXcd(a_fs_.cast<cplx>()));
-    Eigen::MatrixXcd e = -a_ss_.cast<cplx>() - a_sf_.cast<cplx>() * y;
+    const Eigen::MatrixXcd y = lu_.solve(a_fs_c_);
+    Eigen::MatrixXcd e = -a_ss_c_ - a_sf_c_ * y;
     e.diagonal().array() += cplx(0.0, w);
     const Eigen::PartialPivLU<Eigen::MatrixXcd> elu(e);
-    const Eigen::MatrixXcd mb = elu.solve(Eigen::MatrixXcd(b_.cast<cplx>()));
+    const Eigen::MatrixXcd mb = elu.solve(b_c_);
     const Eigen::ComplexEigenSolver<Eigen::MatrixXcd> es(mb, false);
     std::vector<cplx> nu(es.eigenvalues().data(), es.eigenvalues().data() + m_);
     std::sort(nu.begin(), nu.end(), [](cplx a, cplx b) { return std::abs(a) > std::abs(b); });
@@ -125,7 +141,10 @@ class axis_crossing_roots {
  private:
   Eigen::Index m_, nf_;
   Eigen::MatrixXd b_, a_fs_, a_sf_, a_ss_;
-  Eigen::SparseMatrix<double> minus_aff_;
+  Eigen::MatrixXcd a_fs_c_, a_sf_c_, a_ss_c_, b_c_;  // complex copies, made once
+  Eigen::SparseMatrix<cplx> x_;                     // i w I - A_ff at the last w
+  std::vector<Eigen::Index> diag_;                  // positions of its diagonal in valuePtr()
+  std::vector<cplx> diag0_;                         // and their values at w = 0
   direct_solver<Eigen::SparseMatrix<cplx>> lu_;
   int rank_ = 0, factorisations_ = 0;
 };
@@ -222,7 +241,7 @@ inline axis_crossing_result imaginary_axis_crossings(const Eigen::SparseMatrix<d
       if (!(std::isfinite(fa0) && std::isfinite(fb0)) || fa0 * fb0 > 0 || (fa0 == 0 && fb0 == 0)) continue;
       // Illinois on Im q_k(w); the branch is followed by the root nearest the interpolation of q_k
       double a = w_prev, b = w, fa = fa0, fb = fb0;
-      std::complex<double> qa = q_prev[k], qb = q[k], qc = qa;
+      std::complex<double> qa = q_prev[k], qb = q[k];
       int side = 0;
       for (int it = 0; it < opt.max_refinements && b - a > opt.omega_tolerance; ++it) {
         double c = fa == fb ? 0.5 * (a + b) : (a * fb - b * fa) / (fb - fa);
@@ -230,7 +249,7 @@ inline axis_crossing_result imaginary_axis_crossings(const Eigen::SparseMatrix<d
         const double t = (c - a) / (b - a);
         const std::complex<double> guess = qa + t * (qb - qa);
         const std::vector<std::complex<double>> qs = roots.at(c);
-        qc = *std::min_element(qs.begin(), qs.end(), [&](auto u, auto v) { return std::abs(u - guess) < std::abs(v - guess); });
+        const std::complex<double> qc = *std::min_element(qs.begin(), qs.end(), [&](auto u, auto v) { return std::abs(u - guess) < std::abs(v - guess); });
         const double fc = qc.imag();
         if (fc == 0) {
           a = b = c;
@@ -251,8 +270,9 @@ inline axis_crossing_result imaginary_axis_crossings(const Eigen::SparseMatrix<d
           side = +1;
         }
       }
-      const std::complex<double> qr = std::abs(qa.imag()) < std::abs(qb.imag()) ? qa : qb;
-      const double wr = std::abs(qa.imag()) < std::abs(qb.imag()) ? a : b;
+      const bool at_a = std::abs(qa.imag()) < std::abs(qb.imag());
+      const std::complex<double> qr = at_a ? qa : qb;
+      const double wr = at_a ? a : b;
       if (std::isfinite(std::abs(qr)) && std::abs(qr.imag()) <= opt.real_tolerance * (1 + std::abs(qr)))
         res.crossings.push_back({qr.real(), wr, k, std::abs(qr.imag())});
       else
