@@ -287,10 +287,12 @@ constexpr double same_mode_cosine = 0.9;
 boundary arclength_bridge(const structural_case& c, const grid_level& g, const std::vector<double>& machs,
                           const boundary_point& from, int fill) {
   const double m_max = machs.back();
-  tracer_options to = tracer_max_step > 0
-                          ? aerofoil_tracer_options(g, c, from.mach, m_max, fill, 0.5, 0.01, 0.05, tracer_max_step)
-                          : aerofoil_tracer_options(g, c, from.mach, m_max, fill);
+  tracer_options to = aerofoil_tracer_options(g, c, from.mach, m_max, fill);
   hopf_curve_options& ho = to.curve;
+  if (tracer_max_step > 0) {  // --tracer-max-step: the cap, and the first step no larger than it
+    ho.max_step = tracer_max_step;
+    ho.step = std::min(ho.step, tracer_max_step);
+  }
   ho.nu_targets.clear();
   for (double m : machs)
     if (m > from.mach + 1e-9) ho.nu_targets.push_back(m);
