@@ -73,6 +73,7 @@
 #include <optional>
 #include <sstream>
 #include <string>
+#include <utility>
 #include <vector>
 
 using namespace aerohopf;
@@ -214,6 +215,9 @@ struct boundary_point {
   long linear_iterations;
   double hopf_seconds, steady_seconds;
   hopf_point point;  // with the flow state of this Mach number
+  // false for the points of an arclength stretch: their steady_seconds is the unit of cost
+  // (the steady solve where the stretch starts), not a steady solve run at their Mach number
+  bool own_steady = true;
 };
 
 using boundary = std::vector<boundary_point>;
@@ -311,7 +315,7 @@ boundary arclength_bridge(const structural_case& c, const grid_level& g, const s
     hopf_point q = p.point();
     q.mu = std::abs(q.mu);  // Ubar enters only through 1/Ubar^2 (spec 05)
     out.push_back({p.nu, q.mu, p.omega, p.newton_iterations, st.linear_iterations, p.seconds, from.steady_seconds,
-                   std::move(q)});
+                   std::move(q), false});
   };
   // a fold in M smaller than half a listed step (medium grid: the curve turns back by ~1e-4 in M at
   // the Ubar* peak near M = 0.826 and forward again) is traced through; the points on its way
@@ -349,12 +353,24 @@ boundary arclength_bridge(const structural_case& c, const grid_level& g, const s
               "%.5f) up to the next listed Mach number\n",
               from.mach, from.ubar, from.omega);
   symmetric_hopf_curve_result r;
+  const auto t_bridge = clk::now();
+  // The cost of the stretch not in its boundary points' own steps (the re-solved start, the
+  // points back in M, the step that crossed the landed Mach number): charged to its last point,
+  // so that the boundary's hopf_seconds add up to the whole stretch.
+  auto charge_rest = [&] {
+    if (out.empty()) return;
+    double own = 0;
+    for (const auto& q : out) own += q.hopf_seconds;
+    out.back().hopf_seconds += std::max(0.0, seconds_since(t_bridge) - own);
+  };
   try {
     r = trace_symmetric_hopf_curve<4>(family, from.mach, from.point, ho, +1, to.symmetric);
   } catch (const error& e) {  // e.g. the start's nested steady solve: keep what was traced
     std::printf("    arclength failed: %s\n", e.what());
+    charge_rest();
     return out;
   }
+  charge_rest();
   long gmres_hopf = 0, gmres_steady = 0;
   for (const auto& st : r.stats) {
     gmres_hopf += st.linear_iterations;
@@ -374,18 +390,30 @@ boundary arclength_bridge(const structural_case& c, const grid_level& g, const s
 /// then refined by one inverse iteration: hopf_krylov_options::start_iterations). A point is
 /// accepted if its eigenvector's structural part continues the previous one (structural_cosine
 /// >= 0.9); a failed or other-mode point is retried from half the Mach step (down to 1/8), and
-/// the step doubles again after a success. The intermediate converged points are kept.
+/// the step doubles again after a success. The intermediate converged points are kept. Where
+/// no Mach step down to 1/8 converges (and no other mode turned up), natural continuation hands
+/// over to the Hopf-curve tracer (arclength_bridge).
 /// Where even 1/8 of the step finds only the other mode's Hopf point, the continued branch
 /// has ended (it turns back in M between the two Mach numbers) and the boundary JUMPS to that
 /// mode: it is accepted as the start of a new branch, reported on the terminal, and the CSV
-/// carries the jump. (That it is the lowest-Ubar crossing there is not checked.)
+/// carries the jump; the other mode's points found at the larger steps of the same search
+/// continue the new branch and are kept, not solved again. (That the jump point is the lowest
+/// crossing is checked apart: jump_check_part, crossing_check_part.) The wall time of rejected
+/// attempts (failed or other-mode solves, with their steady solves) is charged to the next
+/// written point's hopf_seconds.
 boundary natural_boundary(const structural_case& c, const grid_level& g, const std::vector<double>& machs,
                           const boundary* coarser, int coarser_ratio, int fill, csv_writer& csv) {
   boundary b;
   std::size_t branch_start = 0;  // first point of the current branch (a jump starts a new one)
+  // Wall time of the attempts not accepted since the last written point (failed Hopf solves,
+  // other-mode points, each with the steady solve at its Mach number): charged to the next
+  // written point's hopf_seconds, so that the CSV's hopf_seconds add up to the whole cost of the
+  // boundary beyond one steady solve per point.
+  double rejected_seconds = 0;
   // cosine: structural_cosine to the previous point (NAN for the first point of the boundary;
   // at a jump, to the last point of the ended branch)
-  auto write = [&](const boundary_point& p, double cosine) {
+  auto write = [&](boundary_point p, double cosine) {
+    p.hopf_seconds += std::exchange(rejected_seconds, 0.0);
     b.push_back(p);
     csv.row({p.mach, p.ubar, p.omega, static_cast<long long>(p.newton_iterations),
              static_cast<long long>(p.linear_iterations), p.hopf_seconds, p.steady_seconds});
@@ -399,8 +427,10 @@ boundary natural_boundary(const structural_case& c, const grid_level& g, const s
     const double m_done = b.empty() ? mach : b.back().mach;
     const double full_step = mach - m_done;
     double step = full_step;
-    std::optional<boundary_point> other_mode;  // the other mode's point found at the smallest step
-    double other_cosine = NAN;                 // ... and its structural cosine to b.back()
+    // the other mode's points found in this search, in the order found (falling steps, so falling
+    // M), and the structural cosine of the last one to b.back()
+    std::vector<boundary_point> others;
+    double other_cosine = NAN;
     while (b.empty() || b.back().mach < mach - 1e-9) {
       if (!b.empty()) step = std::min(step, mach - b.back().mach);  // halve the step actually tried
       const double m = b.empty() || step >= mach - b.back().mach ? mach : b.back().mach + step;
@@ -411,8 +441,13 @@ boundary natural_boundary(const structural_case& c, const grid_level& g, const s
       const auto t0 = clk::now();
       if (!b.empty()) {
         guess = b.back().point;
-        if (b.size() >= branch_start + 2) {  // secant predictor in M for Ubar, omega and the eigenvector
-          const auto& p1 = b[b.size() - 2];
+        // secant predictor in M for Ubar, omega and the eigenvector, over a base no shorter than
+        // a tenth of the step: after an arclength stretch the last two points can lie 4e-5 apart
+        // in M (measured), and a secant extrapolated 250 times its base is no predictor
+        std::size_t i1 = b.size() >= branch_start + 2 ? b.size() - 2 : b.size();
+        while (i1 < b.size() && i1 > branch_start && b.back().mach - b[i1].mach < 0.1 * (m - b.back().mach)) --i1;
+        if (i1 < b.size() && b.back().mach - b[i1].mach >= 0.1 * (m - b.back().mach)) {  // else the last point
+          const auto& p1 = b[i1];
           const auto& p2 = b.back();
           const double t = (m - p2.mach) / (p2.mach - p1.mach);
           guess.mu = p2.ubar + t * (p2.ubar - p1.ubar);
@@ -443,31 +478,52 @@ boundary natural_boundary(const structural_case& c, const grid_level& g, const s
         p->hopf_seconds += start_seconds;
         if (!b.empty()) cosine = structural_cosine(b.back().point.p, p->point.p);
       }
+      if (!p) rejected_seconds += st.seconds + seconds_since(t0);
       if (p && b.size() > branch_start && cosine < same_mode_cosine) {
+        rejected_seconds += p->steady_seconds + p->hopf_seconds;  // taken back if it becomes the jump point
         std::printf("    %s: Hopf point Ubar* = %.4f, omega* = %.4f belongs to another mode (structural cosine %.3f "
                     "to the point at M = %.4f)\n",
                     label.c_str(), p->ubar, p->omega, cosine, b.back().mach);
-        other_mode = std::move(p);
+        others.push_back(std::move(*p));
         other_cosine = cosine;
         p.reset();
       }
       if (p) {
         write(*p, cosine);
-        other_mode.reset();
+        others.clear();  // this branch goes on: the other mode's points found above it are not boundary points
         step = std::min(2.0 * step, full_step);
         continue;
       }
       if (b.empty())
         throw convergence_error(aerohopf::internal::concat("boundary ", c.name, " ", g.name,
                                                            ": no Hopf point at the first Mach number ", m));
+      // Natural continuation gives up at 1/8 of the step only: handing over at the second failure
+      // in one listed step saved 2 failed solves (1.2 s each) before the heavy medium stretch at
+      // M = 0.83, but in a trial with the tracer's last points before M = 0.83 placed otherwise
+      // (a fixed-omega kink fallback, not kept) the secant predictor from them failed twice at
+      // 0.84 and sent M = 0.83 -> 0.84 to the tracer too: 47.6 s, 15 failed correctors at kinks.
       if (step < full_step / 8.0 + 1e-12) {
-        if (other_mode) {
+        if (!others.empty()) {
           std::printf("    %s: the branch continued from M = %.4f ends before M = %.4f (no Hopf point of its mode "
                       "within 1/8 of the Mach step); the boundary jumps to the other mode's Hopf point found there\n",
-                      label.c_str(), b.back().mach, other_mode->mach);
+                      label.c_str(), b.back().mach, others.back().mach);
           branch_start = b.size();
-          write(*other_mode, other_cosine);
-          other_mode.reset();
+          // The other mode's points found at the larger steps lie on the new branch up to this
+          // listed Mach number: kept as they are (no second solve at the same M and guess
+          // quality) while each continues the branch (structural cosine to the point before).
+          // Measured on the light medium grid: the re-solves at M = 0.9025, 0.905, 0.91 after
+          // the jump reproduced them to 1e-5 in Ubar*, at 5.8 s.
+          std::vector<std::pair<const boundary_point*, double>> kept = {{&others.back(), other_cosine}};
+          for (auto q = std::next(others.rbegin()); q != others.rend(); ++q) {
+            const boundary_point& last = *kept.back().first;
+            const double cq = structural_cosine(last.point.p, q->point.p);
+            if (q->mach <= last.mach + 1e-9 || cq < same_mode_cosine) break;
+            kept.emplace_back(&*q, cq);
+          }
+          for (const auto& [q, cq] : kept) rejected_seconds -= q->steady_seconds + q->hopf_seconds;
+          for (const auto& [q, cq] : kept) write(*q, cq);  // the rest of rejected_seconds goes to the jump point
+          others.clear();
+          step = std::min(2.0 * step, full_step);
           continue;
         }
         std::cout << "    " << label << ": no convergence from M = " << b.back().mach
@@ -1109,16 +1165,36 @@ int main(int argc, char** argv) {
     {
       csv_writer csv(o.out / "costs.csv", "case,grid,quantity,ratio_to_steady");
       std::cout << "\n=== cost per unit steady solve (same run, same machine) ===\n";
+      const std::vector<double> listed = mach_list(o);
+      auto is_listed = [&](double m) {
+        return std::any_of(listed.begin(), listed.end(), [&](double l) { return std::abs(l - m) < 1e-9; });
+      };
       for (const auto& [key, b] : all) {
-        double hopf = 0, st = 0;
-        for (std::size_t k = 1; k < b.size(); ++k) {  // the first point includes the inverse-power start
+        // the first point includes the inverse-power start; the others are continued. hopf_seconds
+        // include the rejected attempts before each point and the whole arclength stretches.
+        double hopf = 0, st = 0, extra = 0, st_listed = 0;
+        std::size_t n_listed = 0;
+        for (std::size_t k = 1; k < b.size(); ++k) {
           hopf += b[k].hopf_seconds;
           st += b[k].steady_seconds;
+          if (is_listed(b[k].mach)) {
+            st_listed += b[k].steady_seconds;
+            ++n_listed;
+          } else if (b[k].own_steady) {
+            extra += b[k].steady_seconds;  // a steady solve at an intermediate Mach number
+          }
         }
         if (b.size() > 1) {
           std::printf("  %-22s Hopf point / steady solve = %.2f (mean over %zu continued points)\n", key.c_str(),
                       hopf / st, b.size() - 1);
           csv.row({key, std::string(""), std::string("hopf_per_steady"), hopf / st});
+        }
+        if (n_listed > 0) {
+          // everything beyond one steady solve per listed Mach number (intermediate points, their
+          // steady solves, rejected attempts, arclength stretches), per listed steady solve
+          std::printf("  %-22s all Hopf work / steady solve = %.2f (per listed Mach number, %zu continued)\n",
+                      key.c_str(), (hopf + extra) / st_listed, n_listed);
+          csv.row({key, std::string(""), std::string("hopf_per_steady_listed"), (hopf + extra) / st_listed});
         }
       }
       for (double r : march_costs) {
