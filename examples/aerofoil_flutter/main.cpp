@@ -444,10 +444,15 @@ boundary natural_boundary(const structural_case& c, const grid_level& g, const s
         // secant predictor in M for Ubar, omega and the eigenvector, over a base no shorter than
         // a tenth of the step: after an arclength stretch the last two points can lie 4e-5 apart
         // in M (measured), and a secant extrapolated 250 times its base is no predictor
-        std::size_t i1 = b.size() >= branch_start + 2 ? b.size() - 2 : b.size();
-        while (i1 < b.size() && i1 > branch_start && b.back().mach - b[i1].mach < 0.1 * (m - b.back().mach)) --i1;
-        if (i1 < b.size() && b.back().mach - b[i1].mach >= 0.1 * (m - b.back().mach)) {  // else the last point
-          const auto& p1 = b[i1];
+        const double min_base = 0.1 * (m - b.back().mach);
+        std::optional<std::size_t> i1;  // the latest earlier point of the branch that far back; none: the last point
+        for (std::size_t i = b.size() - 1; i-- > branch_start;)
+          if (b.back().mach - b[i].mach >= min_base) {
+            i1 = i;
+            break;
+          }
+        if (i1) {
+          const auto& p1 = b[*i1];
           const auto& p2 = b.back();
           const double t = (m - p2.mach) / (p2.mach - p1.mach);
           guess.mu = p2.ubar + t * (p2.ubar - p1.ubar);
