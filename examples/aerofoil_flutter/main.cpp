@@ -22,6 +22,9 @@
 //   --contact-smoothing d       contact-switch smoothing of the reduced-model part (default 0.05;
 //                               0 = exact Osher switch, whose residual is not C2 at the equilibrium)
 //   --quick                     coarse grid, M = 0.5 .. 0.8 step 0.1, shorter time marching
+//   --tracer-corrector joint|nested   corrector of the arclength hand-over: the flow as an unknown
+//                               of the corrector, one steady Newton step per iteration (joint, the
+//                               default), or a nested steady solve at every iterate's M (nested)
 //   --tracer-max-step s         largest arclength step of the hand-over, in its metric (default 1)
 //   --tracer-dw-tol t           GMRES tolerance of dw0/dnu in the arclength hand-over
 //                               (symmetric_hopf_curve_options::derivative_tolerance)
@@ -136,6 +139,7 @@ bool start_reorthogonalize = false;  // --start-gram-schmidt once|twice: ... of 
 /// and the last, most expensive Newton step (GMRES to 1e-5) is saved. The very coarse check
 /// and the reduced model keep 1e-10.
 double boundary_tolerance = 1e-7;
+bool tracer_joint = true;  // --tracer-corrector joint|nested: symmetric_hopf_curve_options::joint_equilibrium
 double tracer_max_step = 0;  // --tracer-max-step: hopf_curve_options::max_step of the hand-over (0: 1.0)
 double tracer_derivative_tolerance = 0;  // --tracer-dw-tol: symmetric_hopf_curve_options::derivative_tolerance
                                          // of the hand-over (0: aerofoil_tracer_options' value)
@@ -306,6 +310,7 @@ boundary arclength_bridge(const structural_case& c, const grid_level& g, const s
   ho.newton.abs_tolerance = boundary_tolerance;
   if (verbose_newton) ho.newton.observer = newton_progress("      corrector");
   if (tracer_derivative_tolerance > 0) to.symmetric.derivative_tolerance = tracer_derivative_tolerance;
+  to.symmetric.joint_equilibrium = tracer_joint;
   double m_hi = from.mach;
   const double fold_tolerance = 0.005;
   boundary out;
@@ -372,15 +377,17 @@ boundary arclength_bridge(const structural_case& c, const grid_level& g, const s
   }
   charge_rest();
   long gmres_hopf = 0, gmres_steady = 0;
+  int flow_steps = 0;
   for (const auto& st : r.stats) {
     gmres_hopf += st.linear_iterations;
     gmres_steady += st.steady_linear_iterations;
+    flow_steps += st.steady_iterations;
   }
-  std::printf("    arclength: %zu points (%zu beyond M = %.5f), %d failed correctors, %d steps at fixed M or Ubar, "
-              "%d nested steady solves (%.2f s with dw0/dnu), GMRES %ld Hopf + %ld steady and dw0/dnu, %.2f s; "
-              "stop: %s\n",
-              r.points.size(), out.size(), from.mach, r.failed_correctors, r.kink_steps, r.steady_solves,
-              r.steady_seconds, gmres_hopf, gmres_steady, r.seconds,
+  std::printf("    arclength (%s corrector): %zu points (%zu beyond M = %.5f), %d failed correctors, %d steps at fixed M "
+              "or Ubar, %d nested steady solves, %d flow Newton steps (%.2f s with dw0/dnu), GMRES %ld Hopf + %ld "
+              "steady and dw0/dnu, %.2f s; stop: %s\n",
+              tracer_joint ? "joint" : "nested", r.points.size(), out.size(), from.mach, r.failed_correctors,
+              r.kink_steps, r.steady_solves, flow_steps, r.steady_seconds, gmres_hopf, gmres_steady, r.seconds,
               r.stop == hopf_curve_stop::requested ? why.c_str() : r.stop_reason.c_str());
   return out;
 }
@@ -1131,6 +1138,10 @@ int main(int argc, char** argv) {
       } else if (a == "--start-tolerance") {
         start_tolerance = std::stod(next());
         require(start_tolerance > 0 && start_tolerance < 1, "--start-tolerance must be in (0, 1)");
+      } else if (a == "--tracer-corrector") {
+        const std::string v = next();
+        require(v == "joint" || v == "nested", "--tracer-corrector must be joint or nested (got ", v, ")");
+        tracer_joint = v == "joint";
       } else if (a == "--tracer-max-step") {
         tracer_max_step = std::stod(next());
         require(tracer_max_step > 0, "--tracer-max-step must be > 0");

@@ -1,5 +1,5 @@
-// The Krylov tracer of the symmetric Hopf curve with nested steady solves
-// (hopf_curve_symmetric.hpp), checked against independent references:
+// The Krylov tracer of the symmetric Hopf curve with nested steady solves, and with the joint
+// corrector (hopf_curve_symmetric.hpp), checked against independent references:
 //  * a synthetic family whose equilibrium w*(nu) depends on nu but not on mu and whose Hopf
 //    curve is the unit circle mu^2 + nu^2 = 1 (omega = 1 + 0.3 mu), so it turns in nu at nu = 1
 //    (dnu/ds = 0, where the fixed-nu Hopf Jacobian is singular): closed form, the dense spectrum
@@ -176,6 +176,77 @@ TEST(hopf_curve_symmetric, circle_through_the_turning_point_in_nu) {
     EXPECT_NEAR(landed[k]->omega, full_landed[k]->omega, 1e-10) << "landed point " << k;
     EXPECT_LT((landed[k]->w - full_landed[k]->w).lpNorm<Eigen::Infinity>(), 1e-10) << "landed point " << k;
   }
+}
+
+// The joint corrector (w an unknown of the corrector, one flow Newton step per iteration) on the
+// same circle: the same closed-form checks, the nested tracer's landed points, no nested steady
+// solve after the start, and fewer flow Newton steps than the nested solves took.
+TEST(hopf_curve_symmetric, joint_corrector_traces_the_same_circle_without_nested_steady_solves) {
+  auto family = [](double nu) { return circle_family_system(nu); };
+  const double nu0 = 0.6;
+  symmetric_hopf_curve_options joint;
+  joint.joint_equilibrium = true;
+  const auto r = trace_symmetric_hopf_curve<2>(family, nu0, circle_start(nu0, 0.78, 1.2), circle_options(), +1, joint);
+  const auto nested = trace_symmetric_hopf_curve<2>(family, nu0, circle_start(nu0, 0.78, 1.2), circle_options(), +1);
+  auto flow_steps = [](const symmetric_hopf_curve_result& q) {
+    int k = 0, newton = 0;
+    for (std::size_t i = 0; i < q.stats.size(); ++i) {
+      k += q.stats[i].steady_iterations;
+      newton += q.points[i].newton_iterations;
+    }
+    return std::pair{k, newton};
+  };
+  const auto [jk, jn] = flow_steps(r);
+  const auto [nk, nn] = flow_steps(nested);
+  std::cout << "joint circle: " << r.points.size() << " points, " << r.failed_correctors << " failed correctors, "
+            << r.steady_solves << " steady solves, " << jk << " flow Newton steps, " << jn
+            << " corrector iterations; nested: " << nested.points.size() << " points, " << nested.steady_solves
+            << " steady solves, " << nk << " flow Newton steps, " << nn << " corrector iterations\n";
+  EXPECT_EQ(r.stop, hopf_curve_stop::mu_bounds);
+  EXPECT_EQ(r.steady_solves, 1);  // the start's equilibrium only
+  EXPECT_LT(jk, nk);
+  EXPECT_LE(jn, nn + static_cast<int>(nested.points.size()));  // about as many corrector iterations
+  double worst_circle = 0, worst_omega = 0, worst_w = 0, worst_ev = 0;
+  std::vector<const hopf_curve_point*> landed, nested_landed;
+  for (const auto& pt : r.points) {
+    const circle_family_system sys(pt.nu);
+    worst_circle = std::max(worst_circle, std::abs(pt.mu * pt.mu + pt.nu * pt.nu - 1));
+    worst_omega = std::max(worst_omega, std::abs(pt.omega - (1 + 0.3 * pt.mu)));
+    worst_w = std::max(worst_w, (pt.w - sys.equilibrium()).lpNorm<Eigen::Infinity>());
+    worst_ev = std::max(worst_ev, spectrum_distance(sys, pt.w, pt.mu, pt.omega));
+    if (pt.landed) landed.push_back(&pt);
+  }
+  for (const auto& pt : nested.points)
+    if (pt.landed) nested_landed.push_back(&pt);
+  std::cout << "joint circle: max |mu^2+nu^2-1| " << worst_circle << ", max |omega error| " << worst_omega
+            << ", max |w - w*| " << worst_w << ", max dist(i omega, spectrum) " << worst_ev << "\n";
+  EXPECT_LT(worst_circle, 1e-9);
+  EXPECT_LT(worst_omega, 1e-9);
+  EXPECT_LT(worst_w, 1e-10);
+  EXPECT_LT(worst_ev, 1e-8);
+  ASSERT_EQ(landed.size(), 3u);
+  ASSERT_EQ(nested_landed.size(), 3u);
+  for (std::size_t k = 0; k < landed.size(); ++k) {
+    EXPECT_NEAR(landed[k]->nu, nested_landed[k]->nu, 1e-10) << "landed point " << k;
+    EXPECT_NEAR(landed[k]->mu, nested_landed[k]->mu, 1e-10) << "landed point " << k;
+    EXPECT_NEAR(landed[k]->omega, nested_landed[k]->omega, 1e-10) << "landed point " << k;
+    EXPECT_LT((landed[k]->w - nested_landed[k]->w).lpNorm<Eigen::Infinity>(), 1e-10) << "landed point " << k;
+  }
+  // the kink of the C1 family crossed the same way (fixed-nu fallback through the joint corrector)
+  auto kinked = [](double nu) { return circle_family_system(nu, 5.0); };
+  hopf_curve_options o = circle_options();
+  o.nu_targets = {0.75};
+  o.mu_min = -std::numeric_limits<double>::infinity();
+  o.nu_max = 0.8;
+  o.min_step = 1e-4;
+  o.verbose = false;
+  const auto k = trace_symmetric_hopf_curve<2>(kinked, 0.6, circle_start(0.6, 0.78, 1.2), o, 1, joint);
+  EXPECT_EQ(k.stop, hopf_curve_stop::nu_bounds);
+  const hopf_curve_point* at = nullptr;
+  for (const auto& pt : k.points)
+    if (pt.landed && std::abs(pt.nu - 0.75) < 1e-12) at = &pt;
+  ASSERT_NE(at, nullptr);
+  EXPECT_NEAR(at->mu, std::sqrt(1 - 0.5625 + 0.25), 1e-9);
 }
 
 TEST(hopf_curve_symmetric, decreasing_direction_lands_on_the_lower_bound) {
@@ -406,4 +477,22 @@ TEST(hopf_curve_symmetric, aerofoil_heavy_very_coarse_matches_fixed_mach_hopf_so
   // and the full-system tracer's landed point at M = 0.79
   EXPECT_NEAR(std::abs(at->mu), 3.5379158790270173, 1e-7);
   EXPECT_NEAR(at->omega, 0.23343358002885775, 1e-7);
+  // the joint corrector (flow as an unknown of the corrector) lands on the same point
+  symmetric_hopf_curve_options joint;
+  joint.joint_equilibrium = true;
+  o.label = "heavy very coarse joint";
+  const auto rj = trace_symmetric_hopf_curve<4>(make, m0, guess, o, +1, joint);
+  const hopf_curve_point* atj = nullptr;
+  std::size_t kj = 0;
+  for (std::size_t k = 0; k < rj.points.size(); ++k)
+    if (rj.points[k].landed) atj = &rj.points[kj = k];
+  ASSERT_NE(atj, nullptr) << "joint corrector: M = 0.79 not reached";
+  std::cout << "joint: " << rj.points.size() << " points, " << rj.steady_solves << " nested steady solves (nested: "
+            << r.steady_solves << "), Ubar " << atj->mu << ", omega " << atj->omega << "\n";
+  EXPECT_EQ(rj.stats[kj].steady_solves, 0);  // the landing converged by the joint corrector
+  EXPECT_GT(rj.stats[kj].steady_iterations, 0);
+  EXPECT_LT(rj.steady_solves, r.steady_solves);
+  EXPECT_NEAR(atj->mu, h.point.mu, 1e-8);
+  EXPECT_NEAR(atj->omega, h.point.omega, 1e-8);
+  EXPECT_LT((atj->w - w1).lpNorm<Eigen::Infinity>(), 1e-8);
 }

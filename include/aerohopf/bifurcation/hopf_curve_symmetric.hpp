@@ -61,6 +61,31 @@
 // linear extrapolation), one dw0/dnu solve, assembly of A, L, A_mu, one complex BILU(k), four
 // taylor products for G_nu, one GMRES on J.
 //
+// Joint corrector (symmetric_hopf_curve_options::joint_equilibrium). The nested solve above
+// converges w0(nu) at every nu the corrector visits, though only the last one matters. The joint
+// corrector makes w an unknown beside x = (p, mu, nu, omega) and solves [G(x, w); f(w, mu; nu)] = 0
+// by Newton, each step by block elimination of the flow rows (f_w dw + f_nu dnu = -f):
+//     dw = dw_a + dnu dw_nu,   f_w dw_a = -f,   f_w dw_nu = -f_nu      (two real GMRES, one BILU)
+// and then the Hopf rows, with G_w dw substituted,
+//     J(x) dx = -G(x, w) - G_w dw_a,   G_w dw_a = d/de [A(w + e dw_a) p] (central differences),
+// where J is the bordered matrix above with its column G_nu taken along dw_nu at the iterate.
+// f_mu dmu is left out of the flow rows: f_mu = 0 at the equilibrium (it does not depend on mu),
+// so the error of the step vanishes at the solution and Newton stays quadratic. The residual is
+// [G; sigma f] with sigma = newton.abs_tolerance / steady.abs_tolerance, so convergence of its
+// norm to newton.abs_tolerance holds G to that tolerance and f to the steady one: every accepted
+// point is again an exact solution. Cost per corrector iteration: one assembly of f_w and L, one
+// real and one complex BILU(k), two real GMRES and the bordered GMRES; no nested Newton.
+// The joint corrector makes the first attempt of every step (and of every landing, which falls
+// back to the nested corrector when it fails); once it failed, the step's retries (fixed mu or
+// nu, exact tangent, halving) use the nested steady solves. Measured on the heavy aerofoil at
+// its kinks (medium grid, M = 0.8276, joint corrector for every attempt): it failed at every step
+// size down to 0.004 where the nested one crossed at fixed M. Its iterates cross the
+// discretisation's switches in w away from the equilibrium, so the kinks are not on lines
+// nu = const for it. Measured on that grid's stretch M = 0.825 -> 0.83 (four runs each, joint
+// and nested alternated): 16 points, 23 nested steady solves, 106 flow Newton steps, 17.9-23.1 s
+// against 12 points, 74 solves, 154 steps, 18.2-25.3 s; a joint corrector iteration costs about
+// 0.16 s there, a nested one 0.23 s, but its steps grew less (5 iterations per point).
+//
 // Kinks. A discretisation that is only C1 (the Osher flux's subpath switches at sonic points,
 // limiters) has a Jacobian A that is continuous but not differentiable in w, so the Hopf curve
 // is continuous with KINKS wherever a face of the steady flow crosses a switch as nu changes
@@ -69,15 +94,20 @@
 // the curve turns by more than 90 degrees in the metric at a kink, the arclength hyperplane
 // does not meet the next piece near the prediction and no step size helps. As w0 depends on
 // nu only, the switches are crossed at fixed values of nu: the kinks lie on lines nu = const.
-// kink_fallback: after the arclength corrector failed (secant and exact tangent), the same
-// step is retried with the last row fixing nu (or first mu where the curve is nearly vertical
-// in nu), then the other one, at its value predicted along the secant -- a local
-// parametrisation, which crosses the kink as natural continuation does (measured: at a peak
-// of Ubar(M) at a kink, M = 0.8850 coarse grid, only fixed M crosses) -- and accepted if it
-// lands within kink_distance x step of the last point and ahead along the secant. A corrected point that goes back along the secant
-// (possible after the exact-tangent retry at a kink: measured, the trace reversed at M = 0.867
-// and retraced the curve) is rejected like a sheet jump, and so is one (also of the fallback)
-// within a quarter step of the polyline of the points traced before the last three.
+// kink_fallback: after the arclength corrector diverged from the secant prediction, or failed
+// from the secant and the exact tangent, the same step is retried with the last row fixing nu
+// (or first mu where the curve is nearly vertical in nu), then the other one, at its value
+// predicted along the secant -- a local parametrisation, which crosses the kink as natural
+// continuation does (measured: at a peak of Ubar(M) at a kink, M = 0.8850 coarse grid, only
+// fixed M crosses) -- and accepted if it lands within kink_distance x step of the last point
+// and ahead along the secant. The fallback comes before the exact-tangent retry when the
+// corrector diverged (measured on the heavy medium grid, M = 0.825 -> 0.83: the exact tangent
+// never rescued a diverged corrector there, only ones that converged too far from the
+// prediction; failed correctors 7 -> 5, nested steady solves 82 -> 74). A corrected point that
+// goes back along the secant (possible after the exact-tangent retry at a kink: measured, the
+// trace reversed at M = 0.867 and retraced the curve) is rejected like a sheet jump, and so is
+// one (also of the fallback) within a quarter step of the polyline of the points traced before
+// the last three.
 // Nested steady solves that fail from the extrapolated start are retried from the nearest
 // solved equilibrium and then from equilibrium_start(nu) if given (transonic flow: the shock
 // moves fast with M, and Newton from the extrapolation can meet non-physical states).
@@ -166,6 +196,10 @@ struct symmetric_hopf_curve_options {
     return o;
   }();                              ///< nested steady Newton (throw_on_failure is ignored)
   std::size_t equilibrium_cache = 8;  ///< solved equilibria kept (by nu)
+  /// Joint corrector (file comment): the flow w is an unknown of the corrector beside
+  /// (p, mu, nu, omega), one steady Newton step per corrector iteration by block elimination,
+  /// instead of a nested steady solve converged at every nu the corrector visits.
+  bool joint_equilibrium = false;
   /// After the arclength corrector failed along the secant and the exact tangent, retry the
   /// same step at fixed mu or nu (file comment: kinks of the curve of a C1 discretisation);
   /// accepted if it lands ahead along the secant within kink_distance x step of the last point.
@@ -359,9 +393,8 @@ symmetric_hopf_curve_result trace_symmetric_hopf_curve(const F& family, double n
     acc.steady_seconds += std::chrono::duration<double>(clock::now() - t0).count();
   };
   internal::family_cache<F, S> aux(family);  // for dw0/dnu at a cached nu other than the current one
-  // w0(nu) (solved if not cached), warm-started from the nearest cached nu along its dw0/dnu.
-  auto equilibrium_at = [&](double nu, double mu) -> equilibrium& {
-    if (equilibrium* e = find_equilibrium(nu)) return *e;
+  // The solved equilibrium nearest to nu, with its dw0/dnu.
+  auto nearest_equilibrium = [&](double nu, double mu) -> equilibrium& {
     require(!cache.empty(), lab, ": no equilibrium to start the steady solve at nu = ", nu, " from");
     equilibrium* best = &cache.front();
     for (auto& e : cache)
@@ -371,6 +404,23 @@ symmetric_hopf_curve_result trace_symmetric_hopf_curve(const F& family, double n
       const auto [a, lb] = internal::exact_and_lhs_blocks<B>(sb, best->w, mu, lab);
       ensure_derivative(*best, mu, a, lb);
     }
+    return *best;
+  };
+  // Keeps w0(nu) (replacing an entry at the same nu; the oldest goes when the cache is full).
+  auto remember = [&](double nu, vec<double> w, vec<double> dw) -> equilibrium& {
+    if (equilibrium* e = find_equilibrium(nu)) {
+      e->w = std::move(w);
+      e->dw = std::move(dw);
+      return *e;
+    }
+    if (cache.size() >= std::max<std::size_t>(sopt.equilibrium_cache, 2)) cache.erase(cache.begin());
+    cache.push_back({nu, std::move(w), std::move(dw)});
+    return cache.back();
+  };
+  // w0(nu) (solved if not cached), warm-started from the nearest cached nu along its dw0/dnu.
+  auto equilibrium_at = [&](double nu, double mu) -> equilibrium& {
+    if (equilibrium* e = find_equilibrium(nu)) return *e;
+    equilibrium* best = &nearest_equilibrium(nu, mu);
     // warm starts in turn: linear extrapolation, the nearest equilibrium, the user's start
     vec<double> w;
     std::string failures;
@@ -390,15 +440,15 @@ symmetric_hopf_curve_result trace_symmetric_hopf_curve(const F& family, double n
     }
     if (w.size() == 0)
       throw convergence_error(internal::concat(lab, ": no steady state at nu = ", nu, " (", failures, ")"));
-    if (cache.size() >= std::max<std::size_t>(sopt.equilibrium_cache, 2)) cache.erase(cache.begin());
-    cache.push_back({nu, std::move(w), vec<double>()});
-    return cache.back();
+    return remember(nu, std::move(w), vec<double>());
   };
 
   // ---- the Hopf residual and the bordered linear solves ----
-  auto residual = [&](const vec<double>& x, const vec<double>& s, const double* c, double value) {
+  // G(x) at the flow state w (the equilibrium w0(nu) in the nested scheme, the current iterate
+  // in the joint one)
+  auto hopf_residual = [&](const vec<double>& x, const vec<double>& w, const vec<double>& s, const double* c,
+                           double value) {
     const double mu = x[imu], nu = x[inu], om = x[iom];
-    const vec<double>& w = equilibrium_at(nu, mu).w;
     const S& sys = system_at(cur, nu);
     const vec<double> pr = x.segment(ipr, n), pi = x.segment(ipi, n);
     vec<double> f(N);
@@ -409,27 +459,29 @@ symmetric_hopf_curve_result trace_symmetric_hopf_curve(const F& family, double n
     f[iom] = c[0] * x[imu] + c[1] * x[inu] + c[2] * x[iom] - value;
     return f;
   };
+  auto residual = [&](const vec<double>& x, const vec<double>& s, const double* c, double value) {
+    return hopf_residual(x, equilibrium_at(x[inu], x[imu]).w, s, c, value);
+  };
   block_ilu_options cio;
   cio.fill_level = sopt.fill_level;
   cio.context = lab + ": complex BILU(" + std::to_string(sopt.fill_level) + ") of L - i omega I";
   block_ilu<C, B> cilu(cio);
   // Solves J(x) dx = rhs (J with the last row c) by GMRES with the bordered complex-BILU
   // preconditioner; throws convergence_error / singular_matrix_error.
-  auto solve_bordered = [&](const vec<double>& x, const vec<double>& s, const double* c, const vec<double>& rhs,
-                            double tol, const std::string& what) {
+  // At the flow state w with a = f_w(w) (exact) and lb (modified order), and dw_nu the change of
+  // the flow with nu that the column G_nu follows (dw0/dnu; the joint scheme's -f_w^{-1} f_nu).
+  auto solve_bordered_at = [&](const vec<double>& x, const vec<double>& w, const vec<double>& dw_nu,
+                               const real_block& a, const real_block& lb, const vec<double>& s, const double* c,
+                               const vec<double>& rhs, double tol, const std::string& what) {
     const double mu = x[imu], nu = x[inu], om = x[iom];
-    equilibrium& e = equilibrium_at(nu, mu);
-    const vec<double>& w = e.w;
     const S& sys = system_at(cur, nu);
     const vec<double> pr = x.segment(ipr, n), pi = x.segment(ipi, n);
-    const auto [a, lb] = internal::exact_and_lhs_blocks<B>(sys, w, mu, lab);
-    ensure_derivative(e, mu, a, lb);
     const M amu = jacobian_d_mu(sys, w, mu);
     // G_nu by central differences along the linearly extrapolated equilibrium (file comment)
     const double h = nu_h(nu);
     const S& sp = system_at(plus, nu + h);
     const S& sm = system_at(minus, nu - h);
-    const vec<double> wp = w + h * e.dw, wm = w - h * e.dw;
+    const vec<double> wp = w + h * dw_nu, wm = w - h * dw_nu;
     const vec<double> gr = (jacobian_product(sp, wp, mu, pr) - jacobian_product(sm, wm, mu, pr)) / (2 * h);
     const vec<double> gi = (jacobian_product(sp, wp, mu, pi) - jacobian_product(sm, wm, mu, pi)) / (2 * h);
     cilu.compute(shifted(lb, C(0.0, om)));
@@ -453,14 +505,117 @@ symmetric_hopf_curve_result trace_symmetric_hopf_curve(const F& family, double n
     acc.linear_iterations += rep.iterations;
     return dx;
   };
+  // J(x) dx = rhs at the equilibrium w0(nu) (solved if not cached)
+  auto solve_bordered = [&](const vec<double>& x, const vec<double>& s, const double* c, const vec<double>& rhs,
+                            double tol, const std::string& what) {
+    const double mu = x[imu], nu = x[inu];
+    equilibrium& e = equilibrium_at(nu, mu);
+    const auto [a, lb] = internal::exact_and_lhs_blocks<B>(system_at(cur, nu), e.w, mu, lab);
+    ensure_derivative(e, mu, a, lb);
+    return solve_bordered_at(x, e.w, e.dw, a, lb, s, c, rhs, tol, what);
+  };
 
   struct corrected {
     vec<double> x;
     int iterations = 0;
   };
   std::string last_failure;
+  // Joint corrector (symmetric_hopf_curve_options::joint_equilibrium, file comment): Newton on
+  // [x; w] with f(w, mu; nu) = 0 as n more equations (scaled so that the Hopf tolerance on the
+  // whole residual is the steady tolerance on f), each step by block elimination.
+  auto correct_joint = [&](const vec<double>& x0, const vec<double>& s, const double* c, double value,
+                           double radius) -> std::optional<corrected> {
+    const double fscale = opt.newton.abs_tolerance / sopt.steady.abs_tolerance;
+    newton_options no = opt.newton;
+    no.throw_on_failure = true;
+    vec<double> dw_nu_last;
+    try {
+      vec<double> X0(N + n);
+      X0.head(N) = x0;
+      {
+        const equilibrium& e = nearest_equilibrium(x0[inu], x0[imu]);
+        X0.tail(n) = e.w + (x0[inu] - e.nu) * e.dw;
+      }
+      newton_result nr = newton_iterate(
+          [&](const vec<double>& X) {
+            const vec<double> x = X.head(N), w = X.tail(n);
+            const double d = ydist(x, x0);
+            if (!(d <= radius))
+              throw convergence_error(internal::concat(lab, " joint corrector: iterate at nu = ", x[inu], ", mu = ",
+                                                       x[imu], " lies ", d, " from the prediction (more than ", radius,
+                                                       ")"));
+            vec<double> r(N + n);
+            r.head(N) = hopf_residual(x, w, s, c, value);
+            r.tail(n) = fscale * vec<double>(system_at(cur, x[inu]).residual(w, x[imu]));
+            return r;
+          },
+          [&](const vec<double>& X, const vec<double>& r, int it) {
+            const auto t0 = clock::now();
+            const vec<double> x = X.head(N), w = X.tail(n);
+            const double mu = x[imu], nu = x[inu];
+            const std::string what = internal::concat(lab, ": joint corrector iteration ", it, " at nu = ", nu);
+            const S& sys = system_at(cur, nu);
+            const auto [a, lb] = internal::exact_and_lhs_blocks<B>(sys, w, mu, what);
+            rilu.compute(lb);
+            // the flow rows: dw = dw_a + dnu dw_nu (the f_mu dmu term left out: f_mu = 0 at the
+            // equilibrium, so the step's error vanishes at the solution and the rate stays quadratic)
+            const vec<double> f = r.tail(n) / fscale;
+            const double fn = f.norm();
+            vec<double> dwa = vec<double>::Zero(n);
+            if (fn > 0) {
+              const double eta = std::min(sopt.eta_max, std::max(fn, 0.1 * sopt.steady.abs_tolerance / fn));
+              dwa = gmres_real(a, vec<double>(-f), std::min(eta, 0.5), what + ", GMRES for the flow step");
+            }
+            const double h = nu_h(nu);
+            const vec<double> f_nu =
+                (vec<double>(system_at(plus, nu + h).residual(w, mu)) - vec<double>(system_at(minus, nu - h).residual(w, mu))) /
+                (2 * h);
+            vec<double> dwnu = gmres_real(a, vec<double>(-f_nu), sopt.derivative_tolerance, what + ", GMRES for dw/dnu");
+            acc.steady_iterations += 1;
+            acc.steady_seconds += std::chrono::duration<double>(clock::now() - t0).count();
+            // the Hopf rows: G_x dx + G_w dw_nu dnu = -G - G_w dw_a, G_w dw_a = d/de A(w + e dw_a) p by
+            // central differences
+            vec<double> rhs = -r.head(N);
+            const double da = dwa.template lpNorm<Eigen::Infinity>();
+            if (da > 0) {
+              const double e = std::cbrt(Eigen::NumTraits<double>::epsilon()) *
+                               std::max(1.0, w.template lpNorm<Eigen::Infinity>()) / da;
+              const vec<double> wp = w + e * dwa, wm = w - e * dwa;
+              for (const Eigen::Index i0 : {ipr, ipi}) {
+                const vec<double> q = x.segment(i0, n);
+                rhs.segment(i0, n) -= (jacobian_product(sys, wp, mu, q) - jacobian_product(sys, wm, mu, q)) / (2 * e);
+              }
+            }
+            const double gn = r.norm();
+            double tol = sopt.krylov.relative_tolerance;
+            if (sopt.adaptive_tolerance) tol = std::min(sopt.eta_max, std::max(gn, 0.1 * no.abs_tolerance / gn));
+            const vec<double> dx = solve_bordered_at(x, w, dwnu, a, lb, s, c, rhs, std::min(tol, 0.5), what + ", GMRES");
+            vec<double> dX(N + n);
+            dX.head(N) = dx;
+            dX.tail(n) = dwa + dx[inu] * dwnu;
+            dw_nu_last = std::move(dwnu);
+            return dX;
+          },
+          std::move(X0), no, lab + " joint corrector");
+      if (!nr.x.allFinite()) {
+        last_failure = "joint corrector returned a non-finite point";
+        return std::nullopt;
+      }
+      vec<double> x = nr.x.head(N);
+      // dw0/dnu of the last step's iterate: it differs from the converged flow by that step only
+      remember(x[inu], nr.x.tail(n), std::move(dw_nu_last));
+      return corrected{std::move(x), nr.report.iterations};
+    } catch (const error& e) {
+      last_failure = e.what();
+      return std::nullopt;
+    }
+  };
+  // joint corrector for this attempt: each step's first (joint_equilibrium), the nested one for
+  // the retries after it failed (file comment)
+  bool joint_now = sopt.joint_equilibrium;
   auto correct = [&](const vec<double>& x0, const vec<double>& s, const double* c, double value,
                      double radius) -> std::optional<corrected> {
+    if (joint_now) return correct_joint(x0, s, c, value, radius);
     newton_options no = opt.newton;
     no.throw_on_failure = true;
     try {
@@ -623,7 +778,43 @@ symmetric_hopf_curve_result trace_symmetric_hopf_curve(const F& family, double n
     int attempts = 0;
     bool exact_t = false;
     const vec<double> t_secant = t;  // the direction of travel so far (t may become the exact tangent)
+    joint_now = sopt.joint_equilibrium;
     std::optional<corrected> xn;
+    bool kink_tried = false;  // the kink fallback at this step size
+    // Local parametrisation (file comment): the same step at fixed nu or mu at its value
+    // predicted along the secant; nu first (the kinks lie on lines nu = const) unless the
+    // curve is nearly vertical in nu there, then the other one (at a kink where one of
+    // them reverses, only the other crosses it). True: xn holds the accepted point.
+    auto kink_step = [&]() -> bool {
+      kink_tried = true;
+      const double rnu = std::abs(t_secant[inu]) / sig[1], rmu = std::abs(t_secant[imu]) / sig[0];
+      const int order[2] = {rnu >= 0.1 * rmu ? 1 : 0, rnu >= 0.1 * rmu ? 0 : 1};
+      const vec<double> xp = x + ds * t_secant;
+      for (int j : order) {
+        double c[3] = {0, 0, 0};
+        c[j] = 1;
+        auto xk = correct(xp, s, c, yv(xp, j), sopt.iterate_distance * ds);
+        if (xk) {
+          const double dist = ydist(xk->x, x);
+          const bool forward = ydot(vec<double>(xk->x - x), t_secant) > 0 && !revisits(xk->x, ds);
+          if (forward && dist <= sopt.kink_distance * ds) {
+            xn = std::move(xk);
+            ++res.kink_steps;
+            if (opt.verbose && opt.log)
+              *opt.log << lab << ": step " << ds << " from nu = " << x[inu] << ", mu = " << x[imu] << " taken at fixed "
+                       << (j ? "nu" : "mu") << " (a kink of the curve?)" << std::endl;
+            break;
+          }
+          last_failure = forward ? internal::concat("fixed-", j ? "nu" : "mu", " step landed ", dist,
+                                                    " from the last point (step ", ds, ")")
+                                 : internal::concat("fixed-", j ? "nu" : "mu", " step went back along the curve");
+        } else {
+          last_failure = internal::concat("fixed-", j ? "nu" : "mu", " step failed: ", last_failure);
+        }
+        if (opt.verbose && opt.log) *opt.log << lab << ": " << last_failure << std::endl;
+      }
+      return xn.has_value();
+    };
     for (;;) {
       ++attempts;
       const vec<double> xp = x + ds * t;
@@ -633,6 +824,7 @@ symmetric_hopf_curve_result trace_symmetric_hopf_curve(const F& family, double n
         value += c[j] * yv(xp, j);
       }
       xn = correct(xp, s, c, value, sopt.iterate_distance * ds);
+      const bool diverged = !xn;  // the corrector failed (not: converged to a point rejected below)
       if (xn) {
         const double moved = ydist(xn->x, xp);
         const vec<double> d = xn->x - x;
@@ -654,6 +846,14 @@ symmetric_hopf_curve_result trace_symmetric_hopf_curve(const F& family, double n
       }
       if (xn) break;
       ++res.failed_correctors;
+      joint_now = false;  // the retries of this step: nested steady solves (file comment)
+      // A corrector that diverged from the secant prediction: the kink fallback first (file comment)
+      if (diverged && sopt.kink_fallback && !kink_tried) {
+        if (opt.verbose && opt.log)
+          *opt.log << lab << ": step " << ds << " from nu = " << x[inu] << ", mu = " << x[imu] << " failed ("
+                   << last_failure << "), trying it at fixed nu or mu" << std::endl;
+        if (kink_step()) break;
+      }
       bool retry_same = false;
       if (!exact_t && res.points.size() > 1) {
         try {
@@ -672,39 +872,8 @@ symmetric_hopf_curve_result trace_symmetric_hopf_curve(const F& family, double n
         *opt.log << lab << ": step " << ds << " from nu = " << x[inu] << ", mu = " << x[imu] << " failed ("
                  << last_failure << "), " << (retry_same ? "retrying along the exact tangent" : "halving") << std::endl;
       if (retry_same) continue;
-      if (sopt.kink_fallback) {
-        // Local parametrisation (file comment): the same step at fixed nu or mu at its value
-        // predicted along the secant; nu first (the kinks lie on lines nu = const) unless the
-        // curve is nearly vertical in nu there, then the other one (at a kink where one of
-        // them reverses, only the other crosses it).
-        const double rnu = std::abs(t_secant[inu]) / sig[1], rmu = std::abs(t_secant[imu]) / sig[0];
-        const int order[2] = {rnu >= 0.1 * rmu ? 1 : 0, rnu >= 0.1 * rmu ? 0 : 1};
-        const vec<double> xp = x + ds * t_secant;
-        for (int j : order) {
-          double c[3] = {0, 0, 0};
-          c[j] = 1;
-          auto xk = correct(xp, s, c, yv(xp, j), sopt.iterate_distance * ds);
-          if (xk) {
-            const double dist = ydist(xk->x, x);
-            const bool forward = ydot(vec<double>(xk->x - x), t_secant) > 0 && !revisits(xk->x, ds);
-            if (forward && dist <= sopt.kink_distance * ds) {
-              xn = std::move(xk);
-              ++res.kink_steps;
-              if (opt.verbose && opt.log)
-                *opt.log << lab << ": step " << ds << " from nu = " << x[inu] << ", mu = " << x[imu] << " taken at fixed "
-                         << (j ? "nu" : "mu") << " (a kink of the curve?)" << std::endl;
-              break;
-            }
-            last_failure = forward ? internal::concat("fixed-", j ? "nu" : "mu", " step landed ", dist,
-                                                      " from the last point (step ", ds, ")")
-                                   : internal::concat("fixed-", j ? "nu" : "mu", " step went back along the curve");
-          } else {
-            last_failure = internal::concat("fixed-", j ? "nu" : "mu", " step failed: ", last_failure);
-          }
-          if (opt.verbose && opt.log) *opt.log << lab << ": " << last_failure << std::endl;
-        }
-        if (xn) break;
-      }
+      if (sopt.kink_fallback && !kink_tried && kink_step()) break;
+      kink_tried = false;
       ds *= 0.5;
       if (ds < opt.min_step) {
         const std::string why = internal::concat(
@@ -764,7 +933,12 @@ symmetric_hopf_curve_result trace_symmetric_hopf_curve(const F& family, double n
       const vec<double> x0 = x + theta * (xnew - x);
       double c[3] = {0, 0, 0};
       c[l.row] = 1;
+      joint_now = sopt.joint_equilibrium;
       auto xl = correct(x0, s, c, l.value, sopt.iterate_distance * ds);
+      if (!xl && joint_now) {
+        joint_now = false;
+        xl = correct(x0, s, c, l.value, sopt.iterate_distance * ds);
+      }
       if (xl) {
         emit(make_point(xl->x, xl->iterations, 1, ydist(xl->x, x), seconds_since(t_land), true));
       } else {
