@@ -9,6 +9,9 @@
 //                        [--mach-min 0.78] [--mach-max 0.95] [--out out/aerofoil_flutter]
 //                        [--fill k] [--max-points N] [--max-step ds]
 //                        [--mu-scale s] [--nu-scale s] [--omega-scale s]   (metric, default 0.5 0.01 0.05)
+//                        [--corrector nested|joint]   (default nested: a steady solve at every M the
+//                        corrector visits; joint: the flow as an unknown of the corrector, one steady
+//                        Newton step per iteration, nested after a failed attempt)
 // Start: steady flow at mach-min from the free stream, inverse power at the case's (Ubar, omega)
 // guess, solve_hopf_krylov (as main.cpp). Every crossing of M = 0.01 k is landed exactly.
 // Output: <out>/hopf_curve_sym_<case>_<grid>.csv
@@ -43,6 +46,7 @@ struct options {
   int max_points = 400;
   double mu_scale = 0.5, nu_scale = 0.01, omega_scale = 0.05;  // metric of the arclength
   double max_step = 1.0;
+  bool joint = false;  // symmetric_hopf_curve_options::joint_equilibrium
 };
 
 /// Vertex of the parabola through three points (x_k, y_k): a turning point of y(x)... located
@@ -82,6 +86,11 @@ int main(int argc, char** argv) {
       else if (a == "--mu-scale") o.mu_scale = std::stod(next());
       else if (a == "--omega-scale") o.omega_scale = std::stod(next());
       else if (a == "--max-step") o.max_step = std::stod(next());
+      else if (a == "--corrector") {
+        const std::string v = next();
+        require(v == "joint" || v == "nested", "--corrector must be joint or nested (got ", v, ")");
+        o.joint = v == "joint";
+      }
       else throw input_error("unknown option " + a);
     }
     require(o.mach_min < o.mach_max, "--mach-min must be below --mach-max");
@@ -103,6 +112,7 @@ int main(int argc, char** argv) {
     hopf_curve_options& ho = to.curve;
     ho.max_points = o.max_points;
     symmetric_hopf_curve_options& so = to.symmetric;
+    so.joint_equilibrium = o.joint;
     csv_writer csv(o.out / ("hopf_curve_sym_" + c.name + "_" + g.name + ".csv"),
                    "mach,ubar,omega,newton_iterations,linear_iterations,step,seconds,landed");
     so.observer = [&](const hopf_curve_point& p, const symmetric_hopf_curve_stats& s) {
@@ -114,10 +124,12 @@ int main(int argc, char** argv) {
 
     // ---- summary ----
     const auto& pts = r.points;
-    std::printf("\n%zu points, stop: %s\n%d failed correctors, %d steps at fixed Mach or Ubar (kinks), %ld GMRES iterations (Hopf system), %d nested steady "
-                "solves (%.1f s), total %.1f s\n",
-                pts.size(), r.stop_reason.c_str(), r.failed_correctors, r.kink_steps, r.linear_iterations, r.steady_solves,
-                r.steady_seconds, r.seconds);
+    int flow_steps = 0;
+    for (const auto& st : r.stats) flow_steps += st.steady_iterations;
+    std::printf("\n%zu points (%s corrector), stop: %s\n%d failed correctors, %d steps at fixed Mach or Ubar (kinks), %ld "
+                "GMRES iterations (Hopf system), %d nested steady solves, %d steady Newton steps (%.1f s), total %.1f s\n",
+                pts.size(), o.joint ? "joint" : "nested", r.stop_reason.c_str(), r.failed_correctors, r.kink_steps,
+                r.linear_iterations, r.steady_solves, flow_steps, r.steady_seconds, r.seconds);
     if (!r.missed_targets.empty()) {
       std::printf("missed Mach targets:");
       for (double m : r.missed_targets) std::printf(" %.4f", m);
