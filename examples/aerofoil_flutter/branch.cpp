@@ -1,7 +1,7 @@
 // The flutter boundary Ubar(M) of the pitch-plunge NACA 0012 (spec 05) traced from ONE start by
-// pseudo-arclength continuation of the symmetric Hopf curve with Krylov linear algebra and a
-// nested steady solve per Mach number (trace_symmetric_hopf_curve, bifurcation/
-// hopf_curve_symmetric.hpp): through the steep transonic branches of the heavy case (M ~ 0.83
+// pseudo-arclength continuation of the symmetric Hopf curve with Krylov linear algebra, the
+// steady flow an unknown of the corrector (or a nested steady solve per Mach number)
+// (trace_symmetric_hopf_curve, bifurcation/hopf_curve_symmetric.hpp): through the steep transonic branches of the heavy case (M ~ 0.83
 // and 0.89) where natural continuation in M stops, at grid sizes where the full-system tracer
 // (hopf_curve.hpp, sparse LU) is too expensive.
 //
@@ -9,7 +9,7 @@
 //                        [--mach-min 0.78] [--mach-max 0.95] [--out out/aerofoil_flutter]
 //                        [--fill k] [--max-points N] [--max-step ds]
 //                        [--mu-scale s] [--nu-scale s] [--omega-scale s]   (metric, default 0.5 0.01 0.05)
-//                        [--corrector nested|joint]   (default nested: a steady solve at every M the
+//                        [--corrector joint|nested]   (default joint; nested: a steady solve at every M the
 //                        corrector visits; joint: the flow as an unknown of the corrector, one steady
 //                        Newton step per iteration, nested after a failed attempt)
 // Start: steady flow at mach-min from the free stream, inverse power at the case's (Ubar, omega)
@@ -46,7 +46,7 @@ struct options {
   int max_points = 400;
   double mu_scale = 0.5, nu_scale = 0.01, omega_scale = 0.05;  // metric of the arclength
   double max_step = 1.0;
-  bool joint = false;  // symmetric_hopf_curve_options::joint_equilibrium
+  bool joint = true;  // symmetric_hopf_curve_options::joint_equilibrium (--corrector)
 };
 
 /// Vertex of the parabola through three points (x_k, y_k): a turning point of y(x)... located
