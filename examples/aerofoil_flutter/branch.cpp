@@ -86,11 +86,7 @@ int main(int argc, char** argv) {
       else if (a == "--mu-scale") o.mu_scale = std::stod(next());
       else if (a == "--omega-scale") o.omega_scale = std::stod(next());
       else if (a == "--max-step") o.max_step = std::stod(next());
-      else if (a == "--corrector") {
-        const std::string v = next();
-        require(v == "joint" || v == "nested", "--corrector must be joint or nested (got ", v, ")");
-        o.joint = v == "joint";
-      }
+      else if (a == "--corrector") o.joint = joint_corrector(next(), a);
       else throw input_error("unknown option " + a);
     }
     require(o.mach_min < o.mach_max, "--mach-min must be below --mach-max");
@@ -124,12 +120,10 @@ int main(int argc, char** argv) {
 
     // ---- summary ----
     const auto& pts = r.points;
-    int flow_steps = 0;
-    for (const auto& st : r.stats) flow_steps += st.steady_iterations;
     std::printf("\n%zu points (%s corrector), stop: %s\n%d failed correctors, %d steps at fixed Mach or Ubar (kinks), %ld "
                 "GMRES iterations (Hopf system), %d nested steady solves, %d steady Newton steps (%.1f s), total %.1f s\n",
                 pts.size(), o.joint ? "joint" : "nested", r.stop_reason.c_str(), r.failed_correctors, r.kink_steps,
-                r.linear_iterations, r.steady_solves, flow_steps, r.steady_seconds, r.seconds);
+                r.linear_iterations, r.steady_solves, r.steady_iterations, r.steady_seconds, r.seconds);
     if (!r.missed_targets.empty()) {
       std::printf("missed Mach targets:");
       for (double m : r.missed_targets) std::printf(" %.4f", m);

@@ -377,17 +377,15 @@ boundary arclength_bridge(const structural_case& c, const grid_level& g, const s
   }
   charge_rest();
   long gmres_hopf = 0, gmres_steady = 0;
-  int flow_steps = 0;
   for (const auto& st : r.stats) {
     gmres_hopf += st.linear_iterations;
     gmres_steady += st.steady_linear_iterations;
-    flow_steps += st.steady_iterations;
   }
   std::printf("    arclength (%s corrector): %zu points (%zu beyond M = %.5f), %d failed correctors, %d steps at fixed M "
               "or Ubar, %d nested steady solves, %d flow Newton steps (%.2f s with dw0/dnu), GMRES %ld Hopf + %ld "
               "steady and dw0/dnu, %.2f s; stop: %s\n",
               tracer_joint ? "joint" : "nested", r.points.size(), out.size(), from.mach, r.failed_correctors,
-              r.kink_steps, r.steady_solves, flow_steps, r.steady_seconds, gmres_hopf, gmres_steady, r.seconds,
+              r.kink_steps, r.steady_solves, r.steady_iterations, r.steady_seconds, gmres_hopf, gmres_steady, r.seconds,
               r.stop == hopf_curve_stop::requested ? why.c_str() : r.stop_reason.c_str());
   return out;
 }
@@ -1139,9 +1137,7 @@ int main(int argc, char** argv) {
         start_tolerance = std::stod(next());
         require(start_tolerance > 0 && start_tolerance < 1, "--start-tolerance must be in (0, 1)");
       } else if (a == "--tracer-corrector") {
-        const std::string v = next();
-        require(v == "joint" || v == "nested", "--tracer-corrector must be joint or nested (got ", v, ")");
-        tracer_joint = v == "joint";
+        tracer_joint = joint_corrector(next(), a);
       } else if (a == "--tracer-max-step") {
         tracer_max_step = std::stod(next());
         require(tracer_max_step > 0, "--tracer-max-step must be > 0");

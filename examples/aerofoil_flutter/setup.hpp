@@ -96,6 +96,13 @@ inline steady_result steady(const aerofoil_system& s) {
 /// [m0, m_max] with every M = 0.01 k landed exactly; 8 Newton iterations per corrector (3-5
 /// quadratic steps when it converges: fail fast at kinks); BILU(fill); nested steady Newton to
 /// ||f|| <= 1e-10, its third start the pseudo-transient solve from the free stream.
+/// The value of --tracer-corrector / --corrector: true for "joint"
+/// (symmetric_hopf_curve_options::joint_equilibrium), false for "nested".
+inline bool joint_corrector(const std::string& value, const std::string& option) {
+  aerohopf::require(value == "joint" || value == "nested", option, " must be joint or nested (got ", value, ")");
+  return value == "joint";
+}
+
 struct tracer_options {
   aerohopf::hopf_curve_options curve;
   aerohopf::symmetric_hopf_curve_options symmetric;

@@ -118,6 +118,25 @@ hopf_curve_options circle_options() {
   return o;
 }
 
+/// Worst closed-form errors over the points of a traced circle (mu^2 + nu^2 = 1, omega = 1 + 0.3 mu,
+/// w = w*(nu), i omega in the dense spectrum), and its landed points in order.
+struct circle_errors {
+  double circle = 0, omega = 0, w = 0, ev = 0;
+  std::vector<const hopf_curve_point*> landed;
+};
+circle_errors check_circle(const std::vector<hopf_curve_point>& points) {
+  circle_errors e;
+  for (const auto& pt : points) {
+    const circle_family_system sys(pt.nu);
+    e.circle = std::max(e.circle, std::abs(pt.mu * pt.mu + pt.nu * pt.nu - 1));
+    e.omega = std::max(e.omega, std::abs(pt.omega - (1 + 0.3 * pt.mu)));
+    e.w = std::max(e.w, (pt.w - sys.equilibrium()).lpNorm<Eigen::Infinity>());
+    e.ev = std::max(e.ev, spectrum_distance(sys, pt.w, pt.mu, pt.omega));
+    if (pt.landed) e.landed.push_back(&pt);
+  }
+  return e;
+}
+
 double seconds_since(std::chrono::steady_clock::time_point t) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
 }
@@ -136,23 +155,16 @@ TEST(hopf_curve_symmetric, circle_through_the_turning_point_in_nu) {
   EXPECT_EQ(r.stop, hopf_curve_stop::mu_bounds);
   ASSERT_GE(r.points.size(), 10u);
   ASSERT_EQ(r.stats.size(), r.points.size());
-  double nu_hi = -9, worst_circle = 0, worst_omega = 0, worst_w = 0, worst_ev = 0;
-  std::vector<const hopf_curve_point*> landed;
-  for (const auto& pt : r.points) {
-    nu_hi = std::max(nu_hi, pt.nu);
-    const circle_family_system sys(pt.nu);
-    worst_circle = std::max(worst_circle, std::abs(pt.mu * pt.mu + pt.nu * pt.nu - 1));
-    worst_omega = std::max(worst_omega, std::abs(pt.omega - (1 + 0.3 * pt.mu)));
-    worst_w = std::max(worst_w, (pt.w - sys.equilibrium()).lpNorm<Eigen::Infinity>());
-    worst_ev = std::max(worst_ev, spectrum_distance(sys, pt.w, pt.mu, pt.omega));
-    if (pt.landed) landed.push_back(&pt);
-  }
-  std::cout << "symmetric circle: max |mu^2+nu^2-1| " << worst_circle << ", max |omega error| " << worst_omega
-            << ", max |w - w*| " << worst_w << ", max dist(i omega, spectrum) " << worst_ev << "\n";
-  EXPECT_LT(worst_circle, 1e-9);
-  EXPECT_LT(worst_omega, 1e-9);
-  EXPECT_LT(worst_w, 1e-10);
-  EXPECT_LT(worst_ev, 1e-8);
+  double nu_hi = -9;
+  for (const auto& pt : r.points) nu_hi = std::max(nu_hi, pt.nu);
+  const circle_errors err = check_circle(r.points);
+  const auto& landed = err.landed;
+  std::cout << "symmetric circle: max |mu^2+nu^2-1| " << err.circle << ", max |omega error| " << err.omega
+            << ", max |w - w*| " << err.w << ", max dist(i omega, spectrum) " << err.ev << "\n";
+  EXPECT_LT(err.circle, 1e-9);
+  EXPECT_LT(err.omega, 1e-9);
+  EXPECT_LT(err.w, 1e-10);
+  EXPECT_LT(err.ev, 1e-8);
   EXPECT_GT(nu_hi, 0.99);  // through the turning point nu = 1 (mu = 0)
   // nu = 0.8 crossed before the turn (mu = 0.6) and after it (mu = -0.6); then the bound mu = -0.9
   ASSERT_EQ(landed.size(), 3u);
@@ -189,12 +201,9 @@ TEST(hopf_curve_symmetric, joint_corrector_traces_the_same_circle_without_nested
   const auto r = trace_symmetric_hopf_curve<2>(family, nu0, circle_start(nu0, 0.78, 1.2), circle_options(), +1, joint);
   const auto nested = trace_symmetric_hopf_curve<2>(family, nu0, circle_start(nu0, 0.78, 1.2), circle_options(), +1);
   auto flow_steps = [](const symmetric_hopf_curve_result& q) {
-    int k = 0, newton = 0;
-    for (std::size_t i = 0; i < q.stats.size(); ++i) {
-      k += q.stats[i].steady_iterations;
-      newton += q.points[i].newton_iterations;
-    }
-    return std::pair{k, newton};
+    int newton = 0;
+    for (const auto& pt : q.points) newton += pt.newton_iterations;
+    return std::pair{q.steady_iterations, newton};
   };
   const auto [jk, jn] = flow_steps(r);
   const auto [nk, nn] = flow_steps(nested);
@@ -206,24 +215,17 @@ TEST(hopf_curve_symmetric, joint_corrector_traces_the_same_circle_without_nested
   EXPECT_EQ(r.steady_solves, 1);  // the start's equilibrium only
   EXPECT_LT(jk, nk);
   EXPECT_LE(jn, nn + static_cast<int>(nested.points.size()));  // about as many corrector iterations
-  double worst_circle = 0, worst_omega = 0, worst_w = 0, worst_ev = 0;
-  std::vector<const hopf_curve_point*> landed, nested_landed;
-  for (const auto& pt : r.points) {
-    const circle_family_system sys(pt.nu);
-    worst_circle = std::max(worst_circle, std::abs(pt.mu * pt.mu + pt.nu * pt.nu - 1));
-    worst_omega = std::max(worst_omega, std::abs(pt.omega - (1 + 0.3 * pt.mu)));
-    worst_w = std::max(worst_w, (pt.w - sys.equilibrium()).lpNorm<Eigen::Infinity>());
-    worst_ev = std::max(worst_ev, spectrum_distance(sys, pt.w, pt.mu, pt.omega));
-    if (pt.landed) landed.push_back(&pt);
-  }
+  const circle_errors err = check_circle(r.points);
+  const auto& landed = err.landed;
+  std::vector<const hopf_curve_point*> nested_landed;
   for (const auto& pt : nested.points)
     if (pt.landed) nested_landed.push_back(&pt);
-  std::cout << "joint circle: max |mu^2+nu^2-1| " << worst_circle << ", max |omega error| " << worst_omega
-            << ", max |w - w*| " << worst_w << ", max dist(i omega, spectrum) " << worst_ev << "\n";
-  EXPECT_LT(worst_circle, 1e-9);
-  EXPECT_LT(worst_omega, 1e-9);
-  EXPECT_LT(worst_w, 1e-10);
-  EXPECT_LT(worst_ev, 1e-8);
+  std::cout << "joint circle: max |mu^2+nu^2-1| " << err.circle << ", max |omega error| " << err.omega
+            << ", max |w - w*| " << err.w << ", max dist(i omega, spectrum) " << err.ev << "\n";
+  EXPECT_LT(err.circle, 1e-9);
+  EXPECT_LT(err.omega, 1e-9);
+  EXPECT_LT(err.w, 1e-10);
+  EXPECT_LT(err.ev, 1e-8);
   ASSERT_EQ(landed.size(), 3u);
   ASSERT_EQ(nested_landed.size(), 3u);
   for (std::size_t k = 0; k < landed.size(); ++k) {

@@ -166,6 +166,7 @@ struct symmetric_hopf_curve_result : hopf_curve_result {
   int kink_steps = 0;                   ///< steps taken at fixed mu or nu (kink_fallback)
   long linear_iterations = 0;
   int steady_solves = 0;
+  int steady_iterations = 0;  ///< steady Newton iterations (nested solves) or steps (joint corrector)
   double steady_seconds = 0;
 };
 
@@ -198,10 +199,11 @@ struct symmetric_hopf_curve_options {
   std::size_t equilibrium_cache = 8;  ///< solved equilibria kept (by nu)
   /// Joint corrector (file comment): the flow w is an unknown of the corrector beside
   /// (p, mu, nu, omega), one steady Newton step per corrector iteration by block elimination,
-  /// instead of a nested steady solve converged at every nu the corrector visits.
+  /// instead of a nested steady solve converged at every nu the corrector visits. It makes the
+  /// first attempt of each step and landing; the retries after it failed are nested.
   bool joint_equilibrium = false;
-  /// After the arclength corrector failed along the secant and the exact tangent, retry the
-  /// same step at fixed mu or nu (file comment: kinks of the curve of a C1 discretisation);
+  /// After the arclength corrector diverged from the secant prediction, or failed along the
+  /// secant and the exact tangent, retry the same step at fixed mu or nu (file comment: kinks of the curve of a C1 discretisation);
   /// accepted if it lands ahead along the secant within kink_distance x step of the last point.
   bool kink_fallback = true;
   /// A start for the nested steady Newton at nu, tried when the warm starts (extrapolation along
@@ -337,6 +339,10 @@ symmetric_hopf_curve_result trace_symmetric_hopf_curve(const F& family, double n
     acc.steady_linear_iterations += rep.iterations;
     return vec<double>(xp.head(n));
   };
+  // Inexact-Newton forcing (file comment) for a residual of norm fn converging to abs_tol.
+  auto forcing = [&](double fn, double abs_tol) {
+    return std::min(0.5, std::min(sopt.eta_max, std::max(fn, 0.1 * abs_tol / fn)));
+  };
   // Newton on f(w, mu; nu) = 0 from w (file comment); throws convergence_error naming nu.
   auto steady_solve = [&](double nu, double mu, vec<double> w) -> vec<double> {
     const auto t0 = clock::now();
@@ -357,9 +363,8 @@ symmetric_hopf_curve_result trace_symmetric_hopf_curve(const F& family, double n
             } else {
               a = internal::exact_blocks<B>(sys, v, mu, what);
             }
-            const double fn = f.norm();
-            const double eta = std::min(sopt.eta_max, std::max(fn, 0.1 * sopt.steady.abs_tolerance / fn));
-            return vec<double>(gmres_real(a, vec<double>(-f), std::min(eta, 0.5), what + ", GMRES"));
+            return vec<double>(gmres_real(a, vec<double>(-f), forcing(f.norm(), sopt.steady.abs_tolerance),
+                                          what + ", GMRES"));
           },
           std::move(w), no, what);
       acc.steady_solves += 1;
@@ -379,17 +384,22 @@ symmetric_hopf_curve_result trace_symmetric_hopf_curve(const F& family, double n
       if (e.nu == nu) return &e;
     return nullptr;
   };
-  // dw0/dnu = -f_w^{-1} f_nu at a solved equilibrium (f_w = a, preconditioner BILU of lb).
+  // dw/dnu = -f_w^{-1} f_nu at the flow state w (f_w = a; rilu holds the BILU of its
+  // preconditioner), f_nu by central differences in nu
+  auto flow_nu_derivative = [&](const vec<double>& w, double mu, double nu, const real_block& a,
+                                const std::string& what) {
+    const double h = nu_h(nu);
+    const vec<double> f_nu =
+        (vec<double>(system_at(plus, nu + h).residual(w, mu)) - vec<double>(system_at(minus, nu - h).residual(w, mu))) /
+        (2 * h);
+    return gmres_real(a, vec<double>(-f_nu), sopt.derivative_tolerance, what);
+  };
+  // dw0/dnu at a solved equilibrium (f_w = a, preconditioner BILU of lb).
   auto ensure_derivative = [&](equilibrium& e, double mu, const real_block& a, const real_block& lb) {
     if (e.dw.size() == n) return;
     const auto t0 = clock::now();
-    const double h = nu_h(e.nu);
-    const S& sp = system_at(plus, e.nu + h);
-    const S& sm = system_at(minus, e.nu - h);
-    const vec<double> f_nu = (vec<double>(sp.residual(e.w, mu)) - vec<double>(sm.residual(e.w, mu))) / (2 * h);
     rilu.compute(lb);
-    e.dw = gmres_real(a, vec<double>(-f_nu), sopt.derivative_tolerance,
-                      internal::concat(lab, ": dw0/dnu at nu = ", e.nu, ", GMRES"));
+    e.dw = flow_nu_derivative(e.w, mu, e.nu, a, internal::concat(lab, ": dw0/dnu at nu = ", e.nu, ", GMRES"));
     acc.steady_seconds += std::chrono::duration<double>(clock::now() - t0).count();
   };
   internal::family_cache<F, S> aux(family);  // for dw0/dnu at a cached nu other than the current one
@@ -520,6 +530,18 @@ symmetric_hopf_curve_result trace_symmetric_hopf_curve(const F& family, double n
     int iterations = 0;
   };
   std::string last_failure;
+  // GMRES tolerance of a corrector iteration at residual norm fn (file comment)
+  auto corrector_tolerance = [&](double fn) {
+    return sopt.adaptive_tolerance ? forcing(fn, opt.newton.abs_tolerance)
+                                   : std::min(sopt.krylov.relative_tolerance, 0.5);
+  };
+  // Cheap failure (file comment): an iterate x farther than radius from the prediction x0.
+  auto check_radius = [&](const vec<double>& x, const vec<double>& x0, double radius, const char* who) {
+    const double d = ydist(x, x0);
+    if (!(d <= radius))
+      throw convergence_error(internal::concat(lab, " ", who, ": iterate at nu = ", x[inu], ", mu = ", x[imu], " lies ",
+                                               d, " from the prediction (more than ", radius, ")"));
+  };
   // Joint corrector (symmetric_hopf_curve_options::joint_equilibrium, file comment): Newton on
   // [x; w] with f(w, mu; nu) = 0 as n more equations (scaled so that the Hopf tolerance on the
   // whole residual is the steady tolerance on f), each step by block elimination.
@@ -539,11 +561,7 @@ symmetric_hopf_curve_result trace_symmetric_hopf_curve(const F& family, double n
       newton_result nr = newton_iterate(
           [&](const vec<double>& X) {
             const vec<double> x = X.head(N), w = X.tail(n);
-            const double d = ydist(x, x0);
-            if (!(d <= radius))
-              throw convergence_error(internal::concat(lab, " joint corrector: iterate at nu = ", x[inu], ", mu = ",
-                                                       x[imu], " lies ", d, " from the prediction (more than ", radius,
-                                                       ")"));
+            check_radius(x, x0, radius, "joint corrector");
             vec<double> r(N + n);
             r.head(N) = hopf_residual(x, w, s, c, value);
             r.tail(n) = fscale * vec<double>(system_at(cur, x[inu]).residual(w, x[imu]));
@@ -562,15 +580,9 @@ symmetric_hopf_curve_result trace_symmetric_hopf_curve(const F& family, double n
             const vec<double> f = r.tail(n) / fscale;
             const double fn = f.norm();
             vec<double> dwa = vec<double>::Zero(n);
-            if (fn > 0) {
-              const double eta = std::min(sopt.eta_max, std::max(fn, 0.1 * sopt.steady.abs_tolerance / fn));
-              dwa = gmres_real(a, vec<double>(-f), std::min(eta, 0.5), what + ", GMRES for the flow step");
-            }
-            const double h = nu_h(nu);
-            const vec<double> f_nu =
-                (vec<double>(system_at(plus, nu + h).residual(w, mu)) - vec<double>(system_at(minus, nu - h).residual(w, mu))) /
-                (2 * h);
-            vec<double> dwnu = gmres_real(a, vec<double>(-f_nu), sopt.derivative_tolerance, what + ", GMRES for dw/dnu");
+            if (fn > 0)
+              dwa = gmres_real(a, vec<double>(-f), forcing(fn, sopt.steady.abs_tolerance), what + ", GMRES for the flow step");
+            vec<double> dwnu = flow_nu_derivative(w, mu, nu, a, what + ", GMRES for dw/dnu");
             acc.steady_iterations += 1;
             acc.steady_seconds += std::chrono::duration<double>(clock::now() - t0).count();
             // the Hopf rows: G_x dx + G_w dw_nu dnu = -G - G_w dw_a, G_w dw_a = d/de A(w + e dw_a) p by
@@ -586,10 +598,8 @@ symmetric_hopf_curve_result trace_symmetric_hopf_curve(const F& family, double n
                 rhs.segment(i0, n) -= (jacobian_product(sys, wp, mu, q) - jacobian_product(sys, wm, mu, q)) / (2 * e);
               }
             }
-            const double gn = r.norm();
-            double tol = sopt.krylov.relative_tolerance;
-            if (sopt.adaptive_tolerance) tol = std::min(sopt.eta_max, std::max(gn, 0.1 * no.abs_tolerance / gn));
-            const vec<double> dx = solve_bordered_at(x, w, dwnu, a, lb, s, c, rhs, std::min(tol, 0.5), what + ", GMRES");
+            const vec<double> dx =
+                solve_bordered_at(x, w, dwnu, a, lb, s, c, rhs, corrector_tolerance(r.norm()), what + ", GMRES");
             vec<double> dX(N + n);
             dX.head(N) = dx;
             dX.tail(n) = dwa + dx[inu] * dwnu;
@@ -621,17 +631,11 @@ symmetric_hopf_curve_result trace_symmetric_hopf_curve(const F& family, double n
     try {
       newton_result nr = newton_iterate(
           [&](const vec<double>& x) {
-            const double d = ydist(x, x0);
-            if (!(d <= radius))
-              throw convergence_error(internal::concat(lab, " corrector: iterate at nu = ", x[inu], ", mu = ", x[imu],
-                                                       " lies ", d, " from the prediction (more than ", radius, ")"));
+            check_radius(x, x0, radius, "corrector");
             return residual(x, s, c, value);
           },
           [&](const vec<double>& x, const vec<double>& f, int it) {
-            const double fn = f.norm();
-            double tol = sopt.krylov.relative_tolerance;
-            if (sopt.adaptive_tolerance) tol = std::min(sopt.eta_max, std::max(fn, 0.1 * no.abs_tolerance / fn));
-            return vec<double>(solve_bordered(x, s, c, vec<double>(-f), std::min(tol, 0.5),
+            return vec<double>(solve_bordered(x, s, c, vec<double>(-f), corrector_tolerance(f.norm()),
                                               internal::concat(lab, ": GMRES at corrector iteration ", it)));
           },
           x0, no, lab + " corrector");
@@ -673,6 +677,7 @@ symmetric_hopf_curve_result trace_symmetric_hopf_curve(const F& family, double n
     if (sopt.observer) sopt.observer(pt, acc);
     res.linear_iterations += acc.linear_iterations;
     res.steady_solves += acc.steady_solves;
+    res.steady_iterations += acc.steady_iterations;
     res.steady_seconds += acc.steady_seconds;
     res.stats.push_back(acc);
     acc = {};
