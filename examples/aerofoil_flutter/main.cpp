@@ -44,6 +44,7 @@
 //   reduced_envelope.csv        amplitude-dependent growth rate: time marching vs reduced model
 // plot.py in this folder turns them into PNGs.
 #include <aerohopf/bifurcation/axis_crossings.hpp>
+#include <aerohopf/bifurcation/equilibrium_krylov.hpp>
 #include <aerohopf/bifurcation/hopf.hpp>
 #include <aerohopf/bifurcation/hopf_bordered.hpp>
 #include <aerohopf/bifurcation/hopf_curve.hpp>
@@ -67,6 +68,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <deque>
 #include <filesystem>
 #include <fstream>
 #include <iomanip>
@@ -428,6 +430,89 @@ boundary natural_boundary(const structural_case& c, const grid_level& g, const s
                 std::isfinite(cosine) ? fixed(cosine, 3).c_str() : "-");
     std::fflush(stdout);
   };
+  // Steady flows solved in this boundary, by Mach number. A listed Mach number gets the steady
+  // solve from the free stream (the unit of cost) and keeps it for a second attempt there (heavy
+  // medium: M = 0.83 was tried twice before the hand-over). An intermediate Mach number (a
+  // halved step) is not a steady solve the user asked for: its flow is a Newton-Krylov solve
+  // (solve_equilibrium_krylov) from the linear interpolation or extrapolation of the two nearest
+  // flows solved. That is also the fallback where the free-stream solve ends on a NON-SYMMETRIC
+  // (lifting) steady flow, which is no equilibrium with the section at rest
+  // (aerofoil_system::steady_equilibrium throws; measured on the medium grid at M = 0.90125,
+  // C_l = 6.1e-3): Newton from the neighbouring symmetric flows stays on the symmetric branch.
+  // The free-stream solve is the last resort of an intermediate Mach number.
+  struct solved_flow {
+    double mach;
+    steady_result st;
+    bool charged = false;  // its seconds are in rejected_seconds (an attempt there was rejected)
+  };
+  std::deque<solved_flow> flows;  // references stay valid as it grows
+  auto listed = [&](double m) {
+    return std::any_of(machs.begin(), machs.end(), [&](double l) { return std::abs(l - m) < 1e-9; });
+  };
+  // Newton-Krylov from the two nearest solved flows; empty if it fails
+  auto warm_flow = [&](const aerofoil_system& s, double m, double mu) -> vec<double> {
+    std::vector<const solved_flow*> near;
+    for (const auto& f : flows) near.push_back(&f);
+    std::sort(near.begin(), near.end(),
+              [&](const solved_flow* a, const solved_flow* e) { return std::abs(a->mach - m) < std::abs(e->mach - m); });
+    vec<double> w0 = near[0]->st.w;
+    if (near.size() > 1)
+      w0 += (m - near[0]->mach) / (near[1]->mach - near[0]->mach) * (near[1]->st.w - near[0]->st.w);
+    const std::string label = c.name + " " + g.name + " steady Newton-Krylov at M = " + fixed(m, 5);
+    try {
+      equilibrium_krylov_options eo;
+      eo.fill_level = fill;
+      // ||f||_2 <= 1e-10: the free-stream solve (||R|| down 10 orders) ends at 1e-10 .. 3e-8
+      // (measured, coarse and medium grids); from the interpolated flow the shock moves in
+      // 5-15 damped Newton steps before the quadratic ones (medium grid, M = 0.90 .. 0.91)
+      eo.newton.abs_tolerance = 1e-10;
+      eo.newton.max_iterations = 25;
+      const auto r = solve_equilibrium_krylov<4>(s, mu, std::move(w0), eo, label);
+      std::printf("    %s (from M = %.5f%s): %d Newton iterations, %ld GMRES, ||f|| %.2e -> %.2e, %.2f s\n",
+                  label.c_str(), near[0]->mach, near.size() > 1 ? (" and " + fixed(near[1]->mach, 5)).c_str() : "",
+                  r.report.iterations, r.linear_iterations, r.report.residual_history.front(), r.report.final_residual(),
+                  r.seconds);
+      return r.w;
+    } catch (const error& e) {
+      std::printf("    %s failed: %s\n", label.c_str(), e.what());
+      return {};
+    }
+  };
+  auto flow_at = [&](const aerofoil_system& s, double m, double mu) -> solved_flow& {
+    for (auto& f : flows)
+      if (std::abs(f.mach - m) < 1e-12) return f;
+    const auto t0 = clk::now();
+    solved_flow f{m, {}, false};
+    if (!listed(m) && !flows.empty()) f.st.w = warm_flow(s, m, mu);
+    if (f.st.w.size() == 0) {
+      try {
+        f.st = steady(s);
+      } catch (const convergence_error& e) {
+        if (flows.empty()) throw;
+        std::printf("    M = %.5f: %s\n    -> the symmetric flow by Newton-Krylov from the neighbouring Mach numbers\n", m,
+                    e.what());
+        f.st.w = warm_flow(s, m, mu);
+        if (f.st.w.size() == 0) throw;
+      }
+    }
+    f.st.seconds = seconds_since(t0);  // with the failed attempts, if any
+    flows.push_back(std::move(f));
+    return flows.back();
+  };
+  auto charge_flow = [&](double m) {  // an attempt at m was rejected: its steady solve is lost work
+    for (auto& f : flows)
+      if (std::abs(f.mach - m) < 1e-12 && !f.charged) {
+        rejected_seconds += f.st.seconds;
+        f.charged = true;
+      }
+  };
+  auto uncharge_flow = [&](double m) {  // ... unless a point there is written after all
+    for (auto& f : flows)
+      if (std::abs(f.mach - m) < 1e-12 && f.charged) {
+        rejected_seconds -= f.st.seconds;
+        f.charged = false;
+      }
+  };
   for (double mach : machs) {
     const double m_done = b.empty() ? mach : b.back().mach;
     const double full_step = mach - m_done;
@@ -440,7 +525,7 @@ boundary natural_boundary(const structural_case& c, const grid_level& g, const s
       if (!b.empty()) step = std::min(step, mach - b.back().mach);  // halve the step actually tried
       const double m = b.empty() || step >= mach - b.back().mach ? mach : b.back().mach + step;
       const auto s = make_system(g, m, c.mu_s);
-      const auto st = steady(s);
+      const steady_result& st = flow_at(s, m, b.empty() ? c.ubar_guess : b.back().ubar).st;
       hopf_point guess;
       const std::string label = c.name + " " + g.name + " M=" + fixed(m, 4);
       const auto t0 = clk::now();
@@ -488,9 +573,13 @@ boundary natural_boundary(const structural_case& c, const grid_level& g, const s
         p->hopf_seconds += start_seconds;
         if (!b.empty()) cosine = structural_cosine(b.back().point.p, p->point.p);
       }
-      if (!p) rejected_seconds += st.seconds + seconds_since(t0);
+      if (!p) {
+        charge_flow(m);
+        rejected_seconds += seconds_since(t0);
+      }
       if (p && b.size() > branch_start && cosine < same_mode_cosine) {
-        rejected_seconds += p->steady_seconds + p->hopf_seconds;  // taken back if it becomes the jump point
+        charge_flow(m);
+        rejected_seconds += p->hopf_seconds;  // taken back if it becomes the jump point
         std::printf("    %s: Hopf point Ubar* = %.4f, omega* = %.4f belongs to another mode (structural cosine %.3f "
                     "to the point at M = %.4f)\n",
                     label.c_str(), p->ubar, p->omega, cosine, b.back().mach);
@@ -499,6 +588,7 @@ boundary natural_boundary(const structural_case& c, const grid_level& g, const s
         p.reset();
       }
       if (p) {
+        uncharge_flow(m);
         write(*p, cosine);
         others.clear();  // this branch goes on: the other mode's points found above it are not boundary points
         step = std::min(2.0 * step, full_step);
@@ -530,7 +620,10 @@ boundary natural_boundary(const structural_case& c, const grid_level& g, const s
             if (q->mach <= last.mach + 1e-9 || cq < same_mode_cosine) break;
             kept.emplace_back(&*q, cq);
           }
-          for (const auto& [q, cq] : kept) rejected_seconds -= q->steady_seconds + q->hopf_seconds;
+          for (const auto& [q, cq] : kept) {
+            rejected_seconds -= q->hopf_seconds;
+            uncharge_flow(q->mach);
+          }
           for (const auto& [q, cq] : kept) write(*q, cq);  // the rest of rejected_seconds goes to the jump point
           others.clear();
           step = std::min(2.0 * step, full_step);

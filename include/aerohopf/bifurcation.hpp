@@ -2,6 +2,7 @@
 // Umbrella header of the bifurcation layer.
 #include "bifurcation/cayley.hpp"
 #include "bifurcation/continuation.hpp"
+#include "bifurcation/equilibrium_krylov.hpp"
 #include "bifurcation/hopf.hpp"
 #include "bifurcation/hopf_bordered.hpp"
 #include "bifurcation/hopf_curve.hpp"

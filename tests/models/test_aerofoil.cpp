@@ -162,6 +162,30 @@ TEST(aerofoil_system, loads_match_flow_force_integration) {
   EXPECT_NEAR(cma, cm, 1e-12);  // moment about the elastic axis is invariant under rotation about it
 }
 
+// steady_equilibrium returns only equilibria of the COUPLED system: at non-zero incidence the
+// converged flow loads the section at rest (C_l ~ 0.1 here), so it throws and says why; at zero
+// incidence the same call returns a state with f(w, Ubar) ~ 0 for any Ubar.
+TEST(aerofoil_system, steady_equilibrium_refuses_a_flow_that_loads_the_section) {
+  const aerofoil_system lifting(euler_model<2>(coarsen(naca_cgrid(), 8), {.mach = 0.6, .alpha_rad = 0.02}),
+                                structure::pitch_plunge{});
+  try {
+    (void)lifting.steady_equilibrium();
+    FAIL() << "no convergence_error for a lifting flow";
+  } catch (const convergence_error& e) {
+    const std::string msg = e.what();
+    EXPECT_NE(msg.find("C_l = "), std::string::npos) << msg;
+    EXPECT_NE(msg.find("not an equilibrium"), std::string::npos) << msg;
+  }
+  // the same flow is accepted with a load limit above its C_l (the caller's choice)
+  const vec<double> w = lifting.steady_equilibrium({}, 1.0);
+  EXPECT_GT(std::abs(lifting.load_coefficients<double>(w).first), 1e-2);
+  const aerofoil_system symmetric(euler_model<2>(coarsen(naca_cgrid(), 8), {.mach = 0.6, .alpha_rad = 0.0}),
+                                  structure::pitch_plunge{});
+  const vec<double> ws = symmetric.steady_equilibrium();
+  EXPECT_LT(std::abs(symmetric.load_coefficients<double>(ws).first), 1e-9);
+  EXPECT_LT(symmetric.residual<double>(ws, 3.0).norm(), 1e-7);
+}
+
 TEST(aerofoil_system, symmetric_equilibrium_is_independent_of_ubar) {
   auto s = make_system(0.5);
   euler_model<2> flow = s.flow();

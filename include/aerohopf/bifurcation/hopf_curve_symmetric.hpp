@@ -20,7 +20,8 @@
 // free (jacobian_product: a taylor pass through the residual), so every point satisfies the
 // exact equations to the Newton tolerance, whatever the approximations below.
 //
-// Nested steady solve (w0(nu)): Newton on f(w, mu; nu) = 0 with the exact Jacobian as the GMRES
+// Nested steady solve (w0(nu), the Newton-Krylov solve of equilibrium_krylov.hpp): Newton on
+// f(w, mu; nu) = 0 with the exact Jacobian as the GMRES
 // operator, right-preconditioned by the real BILU(k) of lhs_jacobian (the modified-order
 // Jacobian for the aerofoil: BILU of the exact second-order flow Jacobian is poor, spec 05),
 // factorised once per steady solve; inexact-Newton forcing eta = min(eta_max, ||f||) and
@@ -145,6 +146,7 @@
 #include "../linalg/krylov.hpp"
 #include "../nonlinear/newton.hpp"
 #include "../nonlinear/system.hpp"
+#include "equilibrium_krylov.hpp"
 #include "hopf.hpp"
 #include "hopf_bordered.hpp"
 #include "hopf_curve.hpp"
@@ -340,33 +342,22 @@ symmetric_hopf_curve_result trace_symmetric_hopf_curve(const F& family, double n
     return vec<double>(xp.head(n));
   };
   // Inexact-Newton forcing (file comment) for a residual of norm fn converging to abs_tol.
-  auto forcing = [&](double fn, double abs_tol) {
-    return std::min(0.5, std::min(sopt.eta_max, std::max(fn, 0.1 * abs_tol / fn)));
-  };
+  auto forcing = [&](double fn, double abs_tol) { return internal::inexact_forcing(fn, abs_tol, sopt.eta_max); };
   // Newton on f(w, mu; nu) = 0 from w (file comment); throws convergence_error naming nu.
   auto steady_solve = [&](double nu, double mu, vec<double> w) -> vec<double> {
     const auto t0 = clock::now();
     const std::string what = internal::concat(lab, ": steady state at nu = ", nu);
     try {
       const S& sys = system_at(cur, nu);
-      newton_options no = sopt.steady;
-      no.throw_on_failure = true;
-      no.observer = nullptr;
-      real_block a;
-      newton_result nr = newton_iterate(
-          [&](const vec<double>& v) { return vec<double>(sys.residual(v, mu)); },
-          [&](const vec<double>& v, const vec<double>& f, int k) {
-            if (k == 1) {
-              real_block l;
-              std::tie(a, l) = internal::exact_and_lhs_blocks<B>(sys, v, mu, what);
-              rilu.compute(l);
-            } else {
-              a = internal::exact_blocks<B>(sys, v, mu, what);
-            }
-            return vec<double>(gmres_real(a, vec<double>(-f), forcing(f.norm(), sopt.steady.abs_tolerance),
-                                          what + ", GMRES"));
-          },
-          std::move(w), no, what);
+      equilibrium_krylov_options eo;
+      eo.fill_level = sopt.fill_level;
+      eo.newton = sopt.steady;
+      eo.newton.observer = nullptr;
+      eo.eta_max = sopt.eta_max;
+      eo.krylov = sopt.krylov;
+      // rilu keeps the BILU of the start's lhs_jacobian (dw0/dnu reuses it)
+      newton_result nr =
+          internal::equilibrium_newton_krylov<B>(sys, mu, std::move(w), eo, rilu, acc.steady_linear_iterations, what);
       acc.steady_solves += 1;
       acc.steady_iterations += nr.report.iterations;
       acc.steady_seconds += std::chrono::duration<double>(clock::now() - t0).count();

@@ -1,0 +1,148 @@
+#pragma once
+// Newton-Krylov solve of the equilibrium f(w, mu) = 0 of a dynamical system from a NEARBY state:
+// the steady flow at a Mach number next to ones already solved (a continuation in M, the nested
+// steady solves of the symmetric Hopf-curve tracer). The pseudo-transient solver of
+// flow/steady_solver.hpp is the robust start from the free stream; from a good guess it is the
+// wrong tool (measured on the medium aerofoil grid, M = 0.90 -> 0.9012: still 25-71
+// pseudo-time steps, as its CFL law and its relative stopping test are built for a start far away),
+// while Newton converges quadratically in 2-5 steps.
+//
+// Method: Newton on f(w, mu) = 0 with
+//   * the EXACT Jacobian f_w (exact_blocks: the system's block assembly, e.g. the aerofoil's
+//     second-order flow Jacobian) as the GMRES operator, so the convergence is quadratic;
+//   * right preconditioning by the real BILU(k) of lhs_jacobian (the modified-order Jacobian of
+//     the aerofoil: BILU of the exact second-order one is poor, spec 05), factorised ONCE, at the
+//     start (later iterates move w little);
+//   * the inexact-Newton forcing eta_k = min(0.5, eta_max, max(||f_k||, 0.1 tol / ||f_k||)) (GMRES
+//     relative tolerance: loose far away, quadratic near the solution, never tighter than the last
+//     step needs);
+//   * an optional halving line search on ||f|| (newton_options::line_search) against
+//     non-physical or rising iterates.
+// Convergence: ||f(w, mu)||_2 <= newton.abs_tolerance (+ rel_tolerance ||f_0||), or a full step
+// at the rounding floor (newton_options::step_tolerance). Failure (no convergence in
+// max_iterations, a residual that is not finite, a GMRES failure, a non-physical state thrown by the
+// model) is a convergence_error naming `label` and the iterate; the caller's start is never
+// modified (it is taken by value).
+//
+// B: block size of the unknowns for BILU (4 for 2D Euler + pitch-plunge), S any
+// dynamical_system with sparse Jacobians (with block_jacobians the assembly is shared).
+#include <Eigen/Core>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <string>
+#include <utility>
+
+#include "../error.hpp"
+#include "../linalg/block_ilu.hpp"
+#include "../linalg/block_sparse_matrix.hpp"
+#include "../linalg/krylov.hpp"
+#include "../nonlinear/newton.hpp"
+#include "../nonlinear/system.hpp"
+#include "hopf_bordered.hpp"
+
+namespace aerohopf {
+
+struct equilibrium_krylov_options {
+  int fill_level = 1;  ///< k of the real BILU(k) of lhs_jacobian
+  newton_options newton = [] {
+    newton_options o;
+    o.abs_tolerance = 1e-11;  ///< on ||f(w, mu)||_2
+    o.max_iterations = 12;
+    o.line_search = true;     ///< halve while ||f|| does not decrease (or is not finite)
+    return o;
+  }();
+  double eta_max = 1e-2;  ///< largest GMRES relative tolerance (the forcing of the file comment)
+  krylov_options krylov = [] {
+    krylov_options o;
+    o.max_iterations = 2000;
+    o.restart = 80;
+    o.record_history = false;
+    return o;
+  }();  ///< GMRES of the Newton corrections (relative_tolerance is set by the forcing)
+};
+
+struct equilibrium_krylov_result {
+  vec<double> w;             ///< the equilibrium
+  newton_report report;      ///< iterations, ||f|| history
+  long linear_iterations = 0;  ///< GMRES iterations over all Newton steps
+  double seconds = 0;
+};
+
+namespace internal {
+/// Inexact-Newton forcing for a residual of norm fn converging to abs_tol (file comment).
+inline double inexact_forcing(double fn, double abs_tol, double eta_max) {
+  return std::min(0.5, std::min(eta_max, std::max(fn, 0.1 * abs_tol / fn)));
+}
+
+/// The Newton-Krylov equilibrium solve of solve_equilibrium_krylov with the caller's BILU object
+/// (after the call it holds the factorisation of lhs_jacobian at the start, which the symmetric
+/// Hopf-curve tracer reuses for dw0/dnu). linear_iterations is incremented, not reset.
+template <int B, dynamical_system S>
+newton_result equilibrium_newton_krylov(const S& sys, double mu, vec<double> w, const equilibrium_krylov_options& o,
+                                        block_ilu<double, B>& ilu, long& linear_iterations, const std::string& label) {
+  const Eigen::Index n = sys.size();
+  require(w.size() == n, label, ": start has ", w.size(), " entries, system ", n);
+  require(o.newton.abs_tolerance > 0 || o.newton.rel_tolerance > 0, label,
+          ": Newton needs abs_tolerance > 0 or rel_tolerance > 0");
+  require(o.eta_max > 0 && o.eta_max < 1, label, ": eta_max must lie in (0, 1) (got ", o.eta_max, ")");
+  const Eigen::Index padded = padded_block_count(n, B) * B;
+  newton_options no = o.newton;
+  no.throw_on_failure = true;
+  block_sparse_matrix<double, B> a;
+  return newton_iterate(
+      [&](const vec<double>& v) { return vec<double>(sys.residual(v, mu)); },
+      [&](const vec<double>& v, const vec<double>& f, int k) {
+        if (k == 1) {
+          block_sparse_matrix<double, B> l;
+          std::tie(a, l) = exact_and_lhs_blocks<B>(sys, v, mu, label);
+          ilu.compute(l);
+        } else {
+          a = exact_blocks<B>(sys, v, mu, label);
+        }
+        krylov_options ko = o.krylov;
+        ko.relative_tolerance = inexact_forcing(f.norm(), o.newton.abs_tolerance, o.eta_max);
+        ko.throw_on_failure = true;
+        ko.context = internal::concat(label, ", GMRES at Newton iterate ", k);
+        vec<double> rhs = vec<double>::Zero(padded), dx = vec<double>::Zero(padded);
+        rhs.head(n) = -f;
+        linear_iterations += gmres<double>(a, ilu, rhs, dx, ko).iterations;
+        return vec<double>(dx.head(n));
+      },
+      std::move(w), no, label);
+}
+}  // namespace internal
+
+/// Newton-Krylov solve of f(w, mu) = 0 from the nearby state w0 (file comment). Throws
+/// convergence_error (what failed, at which iterate) and input_error for a start of the wrong
+/// size or with non-finite entries.
+template <int B, dynamical_system S>
+  requires is_sparse_matrix_v<jacobian_t<S>>
+equilibrium_krylov_result solve_equilibrium_krylov(const S& sys, double mu, vec<double> w0,
+                                                   const equilibrium_krylov_options& o = {},
+                                                   const std::string& label = "equilibrium (Newton-Krylov)") {
+  require(std::isfinite(mu), label, ": mu is not finite");
+  require(o.fill_level >= 0, label, ": fill level ", o.fill_level, " < 0");
+  const auto t0 = std::chrono::steady_clock::now();
+  block_ilu_options io;
+  io.fill_level = o.fill_level;
+  io.context = label + ": real BILU(" + std::to_string(o.fill_level) + ") of lhs_jacobian";
+  block_ilu<double, B> ilu(io);
+  equilibrium_krylov_result r;
+  try {
+    newton_result nr = internal::equilibrium_newton_krylov<B>(sys, mu, std::move(w0), o, ilu, r.linear_iterations, label);
+    r.w = std::move(nr.x);
+    r.report = std::move(nr.report);
+  } catch (const convergence_error&) {
+    throw;
+  } catch (const input_error&) {
+    throw;
+  } catch (const error& e) {  // a non-physical iterate thrown by the model, a singular pivot
+    throw convergence_error(label + ": " + e.what());
+  }
+  r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return r;
+}
+
+}  // namespace aerohopf

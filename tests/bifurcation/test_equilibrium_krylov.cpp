@@ -1,0 +1,155 @@
+// Newton-Krylov equilibrium solve from a nearby state (bifurcation/equilibrium_krylov.hpp):
+//  * a sparse test system with a closed-form equilibrium, an approximate Jacobian as the
+//    preconditioner (so BILU is not the exact inverse): converges to the closed form, and
+//    quadratically (||f_{k+1}|| <= C ||f_k||^2);
+//  * the heavy-case aerofoil on the very coarse grid at M = 0.80 from the steady flow at
+//    M = 0.79: the same state as the independent pseudo-transient solve from the free stream;
+//  * bad input and non-convergence: clear exceptions, the caller's start untouched.
+#include <gtest/gtest.h>
+
+#include <aerohopf/bifurcation/equilibrium_krylov.hpp>
+#include <aerohopf/flow/naca_cgrid.hpp>
+#include <aerohopf/models/aerofoil.hpp>
+
+#include <cmath>
+#include <iostream>
+#include <string>
+#include <vector>
+
+using namespace aerohopf;
+
+namespace {
+
+/// f(w) = -(K z + z.^3 + 0.2 z.^2 .* shift(z)), z = w - w*, K = tridiag(-1, 2.5, -1):
+/// equilibrium w* (closed form), unique near it; Jacobian sparse (tridiagonal + diagonal),
+/// approximate Jacobian = -(K + 3 diag(z.^2)) without the coupling term (a preconditioner that
+/// is close, not exact).
+class shifted_cubic_system {
+ public:
+  using jacobian_type = Eigen::SparseMatrix<double>;
+  explicit shifted_cubic_system(Eigen::Index n) : n_(n) {}
+  Eigen::Index size() const { return n_; }
+  vec<double> equilibrium() const {
+    vec<double> w(n_);
+    for (Eigen::Index i = 0; i < n_; ++i) w[i] = 1.0 + 0.5 * std::sin(0.7 * static_cast<double>(i));
+    return w;
+  }
+  template <class T>
+  vec<T> residual(const vec<T>& w, const T& /*mu*/) const {
+    const vec<double> we = equilibrium();
+    vec<T> z(n_);
+    for (Eigen::Index i = 0; i < n_; ++i) z[i] = w[i] - T(we[i]);
+    vec<T> f(n_);
+    for (Eigen::Index i = 0; i < n_; ++i) {
+      T kz = T(2.5) * z[i];
+      if (i > 0) kz -= z[i - 1];
+      if (i + 1 < n_) kz -= z[i + 1];
+      const T next = i + 1 < n_ ? z[i + 1] : T(0.0);
+      f[i] = -(kz + z[i] * z[i] * z[i] + T(0.2) * z[i] * z[i] * next);
+    }
+    return f;
+  }
+  jacobian_type jacobian(const vec<double>& w, double mu) const { return assemble(w, mu, true); }
+  jacobian_type approximate_jacobian(const vec<double>& w, double mu) const { return assemble(w, mu, false); }
+
+ private:
+  jacobian_type assemble(const vec<double>& w, double, bool exact) const {
+    const vec<double> z = w - equilibrium();
+    std::vector<Eigen::Triplet<double>> t;
+    for (Eigen::Index i = 0; i < n_; ++i) {
+      const double next = i + 1 < n_ ? z[i + 1] : 0.0;
+      double d = 2.5 + 3.0 * z[i] * z[i];
+      if (exact) d += 0.4 * z[i] * next;
+      t.emplace_back(i, i, -d);
+      if (i > 0) t.emplace_back(i, i - 1, 1.0);
+      if (i + 1 < n_) t.emplace_back(i, i + 1, 1.0 - (exact ? 0.2 * z[i] * z[i] : 0.0));
+    }
+    jacobian_type a(n_, n_);
+    a.setFromTriplets(t.begin(), t.end());
+    return a;
+  }
+  Eigen::Index n_;
+};
+
+}  // namespace
+
+TEST(equilibrium_krylov, closed_form_equilibrium_quadratic_convergence) {
+  const shifted_cubic_system sys(42);  // not a multiple of the block size 4: padding is exercised
+  vec<double> w0 = sys.equilibrium();
+  for (Eigen::Index i = 0; i < w0.size(); ++i) w0[i] += 0.3 * std::cos(1.3 * static_cast<double>(i));
+  const vec<double> w0_copy = w0;
+  equilibrium_krylov_options o;
+  o.fill_level = 0;
+  o.newton.abs_tolerance = 1e-13;
+  const auto r = solve_equilibrium_krylov<4>(sys, 0.0, w0, o, "cubic");
+  EXPECT_EQ(w0, w0_copy);  // the caller's start is not touched
+  EXPECT_TRUE(r.report.converged);
+  EXPECT_LT((r.w - sys.equilibrium()).lpNorm<Eigen::Infinity>(), 1e-13);
+  EXPECT_GT(r.linear_iterations, 0);
+  const auto& h = r.report.residual_history;
+  ASSERT_GE(h.size(), 3u);
+  EXPECT_LE(r.report.iterations, 7);
+  // quadratic once in the basin: ||f_{k+1}|| <= C ||f_k||^2 with a modest C
+  int checked = 0;
+  for (std::size_t k = 0; k + 1 < h.size(); ++k)
+    if (h[k] < 1e-2 && h[k + 1] > 1e-14) {
+      EXPECT_LT(h[k + 1], 10.0 * h[k] * h[k]) << "step " << k;
+      ++checked;
+    }
+  EXPECT_GE(checked, 1);
+}
+
+TEST(equilibrium_krylov, bad_input_and_non_convergence) {
+  const shifted_cubic_system sys(12);
+  vec<double> w0 = sys.equilibrium();
+  w0.array() += 0.5;
+  EXPECT_THROW(solve_equilibrium_krylov<4>(sys, 0.0, vec<double>(w0.head(11))), input_error);
+  vec<double> bad = w0;
+  bad[3] = NAN;
+  EXPECT_THROW(solve_equilibrium_krylov<4>(sys, 0.0, bad), input_error);
+  EXPECT_THROW(solve_equilibrium_krylov<4>(sys, NAN, w0), input_error);
+  equilibrium_krylov_options o;
+  o.newton.max_iterations = 1;
+  try {
+    solve_equilibrium_krylov<4>(sys, 0.0, w0, o, "one-step solve");
+    FAIL() << "no convergence_error";
+  } catch (const convergence_error& e) {
+    const std::string msg = e.what();
+    EXPECT_NE(msg.find("one-step solve"), std::string::npos) << msg;
+    EXPECT_NE(msg.find("no convergence in 1 iterations"), std::string::npos) << msg;
+  }
+  o = {};
+  o.eta_max = 1.5;
+  EXPECT_THROW(solve_equilibrium_krylov<4>(sys, 0.0, w0, o), input_error);
+}
+
+// Heavy case on the very coarse grid (stride 8): the steady flow at M = 0.80 from the one at
+// M = 0.79 (a continuation step of the boundary), against the pseudo-transient solve from the
+// free stream driven 13 orders down.
+TEST(equilibrium_krylov, aerofoil_next_mach_number_matches_pseudo_transient_solve) {
+  using models::aerofoil_system;
+  auto make = [](double mach) {
+    structure::pitch_plunge_parameters p;
+    p.mu_s = 100;
+    return aerofoil_system(flow::euler_model<2>(flow::coarsen(flow::naca_cgrid(), 8), {.mach = mach, .alpha_rad = 0.0}),
+                           structure::pitch_plunge(p));
+  };
+  const aerofoil_system s0 = make(0.79), s1 = make(0.80);
+  const vec<double> w0 = s0.steady_equilibrium();
+  flow::steady_options so;
+  so.residual_drop = 1e-13;
+  so.max_steps = 500;
+  const vec<double> ref = s1.steady_equilibrium(so);
+  equilibrium_krylov_options o;
+  const auto r = solve_equilibrium_krylov<4>(s1, 4.0, w0, o, "M = 0.80 from M = 0.79");
+  std::cout << "M = 0.79 -> 0.80: " << r.report.iterations << " Newton iterations, " << r.linear_iterations
+            << " GMRES iterations, ||f|| " << r.report.residual_history.front() << " -> " << r.report.final_residual()
+            << "\n";
+  EXPECT_TRUE(r.report.converged);
+  EXPECT_LE(r.report.final_residual(), 1e-11);
+  EXPECT_LE(r.report.iterations, 8);
+  EXPECT_LT((r.w - ref).lpNorm<Eigen::Infinity>(), 1e-8);
+  // the equilibrium does not depend on Ubar (structure at rest): the same state at another mu
+  const auto r2 = solve_equilibrium_krylov<4>(s1, 2.0, w0, o);
+  EXPECT_LT((r2.w - r.w).lpNorm<Eigen::Infinity>(), 1e-9);
+}
