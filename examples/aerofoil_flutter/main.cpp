@@ -103,6 +103,11 @@ struct options {
   grid_level verify_grid = level_named("medium");
 };
 
+/// true if m is one of the listed Mach numbers (to 1e-9)
+bool is_listed(const std::vector<double>& machs, double m) {
+  return std::any_of(machs.begin(), machs.end(), [&](double l) { return std::abs(l - m) < 1e-9; });
+}
+
 std::vector<double> mach_list(const options& o) {
   std::vector<double> m;
   if (o.mach_step > 0) {
@@ -446,9 +451,6 @@ boundary natural_boundary(const structural_case& c, const grid_level& g, const s
     bool charged = false;  // its seconds are in rejected_seconds (an attempt there was rejected)
   };
   std::deque<solved_flow> flows;  // references stay valid as it grows
-  auto listed = [&](double m) {
-    return std::any_of(machs.begin(), machs.end(), [&](double l) { return std::abs(l - m) < 1e-9; });
-  };
   // Newton-Krylov from the two nearest solved flows; empty if it fails
   auto warm_flow = [&](const aerofoil_system& s, double m, double mu) -> vec<double> {
     std::vector<const solved_flow*> near;
@@ -483,7 +485,7 @@ boundary natural_boundary(const structural_case& c, const grid_level& g, const s
       if (std::abs(f.mach - m) < 1e-12) return f;
     const auto t0 = clk::now();
     solved_flow f{m, {}, false};
-    if (!listed(m) && !flows.empty()) f.st.w = warm_flow(s, m, mu);
+    if (!is_listed(machs, m) && !flows.empty()) f.st.w = warm_flow(s, m, mu);
     if (f.st.w.size() == 0) {
       try {
         f.st = steady(s);
@@ -499,18 +501,13 @@ boundary natural_boundary(const structural_case& c, const grid_level& g, const s
     flows.push_back(std::move(f));
     return flows.back();
   };
-  auto charge_flow = [&](double m) {  // an attempt at m was rejected: its steady solve is lost work
+  // charged = true: an attempt at m was rejected, its steady solve is lost work; false: a point
+  // there is written after all
+  auto set_charged = [&](double m, bool charged) {
     for (auto& f : flows)
-      if (std::abs(f.mach - m) < 1e-12 && !f.charged) {
-        rejected_seconds += f.st.seconds;
-        f.charged = true;
-      }
-  };
-  auto uncharge_flow = [&](double m) {  // ... unless a point there is written after all
-    for (auto& f : flows)
-      if (std::abs(f.mach - m) < 1e-12 && f.charged) {
-        rejected_seconds -= f.st.seconds;
-        f.charged = false;
+      if (std::abs(f.mach - m) < 1e-12 && f.charged != charged) {
+        rejected_seconds += charged ? f.st.seconds : -f.st.seconds;
+        f.charged = charged;
       }
   };
   for (double mach : machs) {
@@ -574,11 +571,11 @@ boundary natural_boundary(const structural_case& c, const grid_level& g, const s
         if (!b.empty()) cosine = structural_cosine(b.back().point.p, p->point.p);
       }
       if (!p) {
-        charge_flow(m);
+        set_charged(m, true);
         rejected_seconds += seconds_since(t0);
       }
       if (p && b.size() > branch_start && cosine < same_mode_cosine) {
-        charge_flow(m);
+        set_charged(m, true);
         rejected_seconds += p->hopf_seconds;  // taken back if it becomes the jump point
         std::printf("    %s: Hopf point Ubar* = %.4f, omega* = %.4f belongs to another mode (structural cosine %.3f "
                     "to the point at M = %.4f)\n",
@@ -588,7 +585,7 @@ boundary natural_boundary(const structural_case& c, const grid_level& g, const s
         p.reset();
       }
       if (p) {
-        uncharge_flow(m);
+        set_charged(m, false);
         write(*p, cosine);
         others.clear();  // this branch goes on: the other mode's points found above it are not boundary points
         step = std::min(2.0 * step, full_step);
@@ -622,7 +619,7 @@ boundary natural_boundary(const structural_case& c, const grid_level& g, const s
           }
           for (const auto& [q, cq] : kept) {
             rejected_seconds -= q->hopf_seconds;
-            uncharge_flow(q->mach);
+            set_charged(q->mach, false);
           }
           for (const auto& [q, cq] : kept) write(*q, cq);  // the rest of rejected_seconds goes to the jump point
           others.clear();
@@ -1271,9 +1268,6 @@ int main(int argc, char** argv) {
       csv_writer csv(o.out / "costs.csv", "case,grid,quantity,ratio_to_steady");
       std::cout << "\n=== cost per unit steady solve (same run, same machine) ===\n";
       const std::vector<double> listed = mach_list(o);
-      auto is_listed = [&](double m) {
-        return std::any_of(listed.begin(), listed.end(), [&](double l) { return std::abs(l - m) < 1e-9; });
-      };
       for (const auto& [key, b] : all) {
         // the first point includes the inverse-power start; the others are continued. hopf_seconds
         // include the rejected attempts before each point and the whole arclength stretches.
@@ -1282,7 +1276,7 @@ int main(int argc, char** argv) {
         for (std::size_t k = 1; k < b.size(); ++k) {
           hopf += b[k].hopf_seconds;
           st += b[k].steady_seconds;
-          if (is_listed(b[k].mach)) {
+          if (is_listed(listed, b[k].mach)) {
             st_listed += b[k].steady_seconds;
             ++n_listed;
           } else if (b[k].own_steady) {
