@@ -25,6 +25,12 @@
 //   --tracer-corrector joint|nested   corrector of the arclength hand-over: the flow as an unknown
 //                               of the corrector, one steady Newton step per iteration (joint, the
 //                               default), or a nested steady solve at every iterate's M (nested)
+//   --jump-search bottom|top    where the start from the previous point converges to another mode at
+//                               the full Mach step, try 1/8 of the step next (bottom, default) or
+//                               halve the step down to 1/8 (top)
+//   --coarse-restart on|off     where the start from the previous boundary point fails at a listed
+//                               Mach number, restart from the coarser grid's point there before
+//                               halving the step (default on; finer grids of a multi-grid run only)
 //   --tracer-max-step s         largest arclength step of the hand-over, in its metric (default 1)
 //   --tracer-dw-tol t           GMRES tolerance of dw0/dnu in the arclength hand-over
 //                               (symmetric_hopf_curve_options::derivative_tolerance)
@@ -148,6 +154,8 @@ bool start_reorthogonalize = false;  // --start-gram-schmidt once|twice: ... of 
 double boundary_tolerance = 1e-7;
 bool tracer_joint = true;  // --tracer-corrector joint|nested: symmetric_hopf_curve_options::joint_equilibrium
 double tracer_max_step = 0;  // --tracer-max-step: hopf_curve_options::max_step of the hand-over (0: 1.0)
+bool jump_search_bottom = true;  // --jump-search bottom|top: natural_boundary's search after an other-mode point
+bool use_coarse_restart = true;  // --coarse-restart on|off: natural_boundary's grid-sequenced restart
 double tracer_derivative_tolerance = 0;  // --tracer-dw-tol: symmetric_hopf_curve_options::derivative_tolerance
                                          // of the hand-over (0: aerofoil_tracer_options' value)
 
@@ -260,6 +268,13 @@ std::optional<boundary_point> hopf_at(const aerofoil_system& s, double mach, con
   // a bound of 1 (monotonicity) also stopped the light medium point at M = 0.905, which rises
   // 1.43x at iteration 3 and then converges
   ho.newton.max_contraction = 2.0;
+  // The contraction test starts at the second step (the first may raise ||F||); a first step
+  // that raises it more than 100x is abandoned too (newton_options::divergence_factor).
+  // Measured, ||F_1|| / ||F_0|| over the default coarse and medium boundaries, both cases: at
+  // most 33 where Newton then converged (heavy coarse M = 0.91, the other mode), 125-1812 at the
+  // attempts that failed after 5-7 iterations (heavy, M = 0.9025 and 0.82625: omega* -> 4-6, Ubar*
+  // -> 1e85); one failure rose 92x and is still left to the contraction test.
+  ho.newton.divergence_factor = 100.0;
   const auto t0 = clk::now();
   try {
     hopf_result h = solve_hopf_krylov<4>(s, g, ho, ko);
@@ -402,9 +417,13 @@ boundary arclength_bridge(const structural_case& c, const grid_level& g, const s
 /// then refined by one inverse iteration: hopf_krylov_options::start_iterations). A point is
 /// accepted if its eigenvector's structural part continues the previous one (structural_cosine
 /// >= 0.9); a failed or other-mode point is retried from half the Mach step (down to 1/8), and
-/// the step doubles again after a success. The intermediate converged points are kept. Where
+/// the step doubles again after a success. The intermediate converged points are kept. On a
+/// finer grid of a multi-grid run, a listed Mach number whose start from the previous point fails
+/// is first restarted from the coarser grid's point there (coarse_restart below). Where
 /// no Mach step down to 1/8 converges (and no other mode turned up), natural continuation hands
 /// over to the Hopf-curve tracer (arclength_bridge).
+/// Where the start from the previous point converges to the other mode at the full step, 1/8 of
+/// the step is tried next (the jump search from the bottom, comment at its use below).
 /// Where even 1/8 of the step finds only the other mode's Hopf point, the continued branch
 /// has ended (it turns back in M between the two Mach numbers) and the boundary JUMPS to that
 /// mode: it is accepted as the start of a new branch, reported on the terminal, and the CSV
@@ -510,6 +529,40 @@ boundary natural_boundary(const structural_case& c, const grid_level& g, const s
         f.charged = charged;
       }
   };
+  // Grid sequencing at a listed Mach number where the start from the previous point failed:
+  // the coarser boundary's point at that Mach number (eigenvector prolonged, its Ubar* and
+  // omega*) is the start, as for the first point. It is what the original work did by hand on
+  // the heavy case's steep branches ("computed separately from coarse-grid information"), here
+  // automatic. The point it finds is accepted like any other: on the continued branch if its mode
+  // continues it, else as the other mode's point that a jump may take (the halved steps below
+  // decide). Tried once per Mach number (the result is kept; a second failure of the start from
+  // the previous point there reuses it at no cost: its time was charged the first time). Where
+  // it fails too, the step halving and the arclength hand-over go on as before.
+  std::map<double, std::optional<boundary_point>> restarts;
+  auto coarse_restart = [&](const aerofoil_system& s, double m, const steady_result& st,
+                            const std::string& label) -> std::optional<boundary_point> {
+    if (const auto it = restarts.find(m); it != restarts.end()) {
+      if (!it->second) return std::nullopt;
+      boundary_point q = *it->second;
+      q.hopf_seconds = 0;  // charged when it was solved
+      std::printf("    %s: the coarse-grid restart found before: Ubar* = %.6f, omega* = %.6f\n", label.c_str(), q.ubar,
+                  q.omega);
+      return q;
+    }
+    const auto cp = std::find_if(coarser->begin(), coarser->end(),
+                                 [&](const boundary_point& q) { return std::abs(q.mach - m) < 1e-9; });
+    if (cp == coarser->end()) return std::nullopt;
+    const auto t0 = clk::now();
+    const auto sc = make_system({"coarser", g.stride * coarser_ratio}, m, c.mu_s);
+    hopf_point guess = cp->point;
+    guess.p = s.prolong_from<cplx>(sc, coarser_ratio, cp->point.p);
+    std::printf("    %s: restart from the coarse-grid point (Ubar* = %.6f, omega* = %.6f)\n", label.c_str(), cp->ubar,
+                cp->omega);
+    auto q = hopf_at(s, m, st, guess, fill, label + " (coarse-grid restart)");
+    if (q) q->hopf_seconds = seconds_since(t0);
+    restarts[m] = q;
+    return q;
+  };
   for (double mach : machs) {
     const double m_done = b.empty() ? mach : b.back().mach;
     const double full_step = mach - m_done;
@@ -565,14 +618,21 @@ boundary natural_boundary(const structural_case& c, const grid_level& g, const s
       }
       const double start_seconds = seconds_since(t0);
       auto p = hopf_at(s, m, st, guess, fill, label);
-      double cosine = NAN;
-      if (p) {
-        p->hopf_seconds += start_seconds;
-        if (!b.empty()) cosine = structural_cosine(b.back().point.p, p->point.p);
-      }
-      if (!p) {
+      auto t_attempt = t0;  // start of the attempt whose time a failure charges to rejected_seconds
+      if (p) p->hopf_seconds += start_seconds;
+      const bool restarted = !p && use_coarse_restart && coarser && !b.empty() && is_listed(machs, m);
+      if (restarted) {
+        // grid sequencing where the start from the previous point failed (file comment above)
         set_charged(m, true);
         rejected_seconds += seconds_since(t0);
+        t_attempt = clk::now();
+        p = coarse_restart(s, m, st, label);
+      }
+      double cosine = NAN;
+      if (p && !b.empty()) cosine = structural_cosine(b.back().point.p, p->point.p);
+      if (!p) {
+        set_charged(m, true);
+        rejected_seconds += seconds_since(t_attempt);
       }
       if (p && b.size() > branch_start && cosine < same_mode_cosine) {
         set_charged(m, true);
@@ -639,6 +699,20 @@ boundary natural_boundary(const structural_case& c, const grid_level& g, const s
           return b;
         }
         step = full_step;  // natural continuation resumes from the last point of the arclength stretch
+        continue;
+      }
+      // Jump search from the bottom: where the start from the previous point CONVERGED to the
+      // other mode at the full listed step, the continued branch has most likely ended just past
+      // its last point (turned back in M), so the smallest step (1/8) is tried first rather than
+      // halving down to it; if the branch goes on there, the step doubles from it as after any
+      // success. Measured at the three such jumps of the default run: the branch ended within 1/8
+      // of the step at two (light and heavy medium, M = 0.90 -> 0.91) and between 1/8 and 1/4 at
+      // the third (heavy coarse). Where the start FAILED, the step is halved (the branch may go on
+      // close below m: heavy medium M = 0.83, whose branch continues to 0.825).
+      if (jump_search_bottom && !restarted && !others.empty() && std::abs(others.back().mach - m) < 1e-12 &&
+          step > 0.5 * full_step) {
+        step = full_step / 8.0;
+        std::cout << "    the other mode at the full step: retrying with the smallest Mach step " << step << "\n";
         continue;
       }
       step *= 0.5;
@@ -1228,6 +1302,14 @@ int main(int argc, char** argv) {
         require(start_tolerance > 0 && start_tolerance < 1, "--start-tolerance must be in (0, 1)");
       } else if (a == "--tracer-corrector") {
         tracer_joint = joint_corrector(next(), a);
+      } else if (a == "--jump-search") {
+        const std::string v = next();
+        require(v == "bottom" || v == "top", "--jump-search takes bottom or top, not ", v);
+        jump_search_bottom = v == "bottom";
+      } else if (a == "--coarse-restart") {
+        const std::string v = next();
+        require(v == "on" || v == "off", "--coarse-restart takes on or off, not ", v);
+        use_coarse_restart = v == "on";
       } else if (a == "--tracer-max-step") {
         tracer_max_step = std::stod(next());
         require(tracer_max_step > 0, "--tracer-max-step must be > 0");

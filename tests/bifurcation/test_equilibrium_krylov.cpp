@@ -7,6 +7,8 @@
 //  * bad input and non-convergence: clear exceptions, the caller's start untouched.
 #include <gtest/gtest.h>
 
+#include "support/aerofoil_cases.hpp"
+
 #include <aerohopf/bifurcation/equilibrium_krylov.hpp>
 #include <aerohopf/flow/naca_cgrid.hpp>
 #include <aerohopf/models/aerofoil.hpp>
@@ -128,12 +130,7 @@ TEST(equilibrium_krylov, bad_input_and_non_convergence) {
 // free stream driven 13 orders down.
 TEST(equilibrium_krylov, aerofoil_next_mach_number_matches_pseudo_transient_solve) {
   using models::aerofoil_system;
-  auto make = [](double mach) {
-    structure::pitch_plunge_parameters p;
-    p.mu_s = 100;
-    return aerofoil_system(flow::euler_model<2>(flow::coarsen(flow::naca_cgrid(), 8), {.mach = mach, .alpha_rad = 0.0}),
-                           structure::pitch_plunge(p));
-  };
+  const auto make = test_support::heavy_very_coarse_aerofoil;
   const aerofoil_system s0 = make(0.79), s1 = make(0.80);
   const vec<double> w0 = s0.steady_equilibrium();
   flow::steady_options so;

@@ -15,6 +15,8 @@
 
 #include <gtest/gtest.h>
 
+#include "support/aerofoil_cases.hpp"
+
 #include <Eigen/Dense>
 #include <Eigen/SparseCore>
 
@@ -422,12 +424,7 @@ TEST(hopf_curve_symmetric, abandons_a_corrector_that_leaves_the_trust_radius) {
 // the landed point at M = 0.79.
 TEST(hopf_curve_symmetric, aerofoil_heavy_very_coarse_matches_fixed_mach_hopf_solve) {
   using models::aerofoil_system;
-  auto make = [](double mach) {
-    structure::pitch_plunge_parameters p;
-    p.mu_s = 100;
-    return aerofoil_system(flow::euler_model<2>(flow::coarsen(flow::naca_cgrid(), 8), {.mach = mach, .alpha_rad = 0.0}),
-                           structure::pitch_plunge(p));
-  };
+  const auto make = test_support::heavy_very_coarse_aerofoil;
   const double m0 = 0.78, m1 = 0.79;
   const auto t0 = std::chrono::steady_clock::now();
   const aerofoil_system s0 = make(m0);
