@@ -430,30 +430,17 @@ boundary arclength_bridge(const structural_case& c, const grid_level& g, const s
 /// carries the jump; the other mode's points found at the larger steps of the same search
 /// continue the new branch and are kept, not solved again. (That the jump point is the lowest
 /// crossing is checked apart: jump_check_part, crossing_check_part.) The wall time of rejected
-/// attempts (failed or other-mode solves, with their steady solves) is charged to the next
-/// written point's hopf_seconds.
+/// attempts (failed or other-mode solves, with their steady solves at intermediate Mach
+/// numbers) is charged to the next written point's hopf_seconds.
 boundary natural_boundary(const structural_case& c, const grid_level& g, const std::vector<double>& machs,
                           const boundary* coarser, int coarser_ratio, int fill, csv_writer& csv) {
   boundary b;
   std::size_t branch_start = 0;  // first point of the current branch (a jump starts a new one)
   // Wall time of the attempts not accepted since the last written point (failed Hopf solves,
-  // other-mode points, each with the steady solve at its Mach number): charged to the next
-  // written point's hopf_seconds, so that the CSV's hopf_seconds add up to the whole cost of the
-  // boundary beyond one steady solve per point.
+  // other-mode points, each with the steady solve at its Mach number if that is not a listed
+  // one): charged to the next written point's hopf_seconds, so that the CSV's hopf_seconds add up
+  // to the whole cost of the boundary beyond one steady solve per point.
   double rejected_seconds = 0;
-  // cosine: structural_cosine to the previous point (NAN for the first point of the boundary;
-  // at a jump, to the last point of the ended branch)
-  auto write = [&](boundary_point p, double cosine) {
-    p.hopf_seconds += std::exchange(rejected_seconds, 0.0);
-    b.push_back(p);
-    csv.row({p.mach, p.ubar, p.omega, static_cast<long long>(p.newton_iterations),
-             static_cast<long long>(p.linear_iterations), p.hopf_seconds, p.steady_seconds});
-    std::printf("  %-6s %-8s M = %.4f  Ubar* = %.6f  omega* = %.6f  Newton %d  GMRES %5ld  hopf %.2f s  steady %.2f s  (ratio %.2f)  mode cosine %s\n",
-                c.name.c_str(), g.name.c_str(), p.mach, p.ubar, p.omega, p.newton_iterations, p.linear_iterations,
-                p.hopf_seconds, p.steady_seconds, p.hopf_seconds / p.steady_seconds,
-                std::isfinite(cosine) ? fixed(cosine, 3).c_str() : "-");
-    std::fflush(stdout);
-  };
   // Steady flows solved in this boundary, by Mach number. A listed Mach number gets the steady
   // solve from the free stream (the unit of cost) and keeps it for a second attempt there (heavy
   // medium: M = 0.83 was tried twice before the hand-over). An intermediate Mach number (a
@@ -467,9 +454,27 @@ boundary natural_boundary(const structural_case& c, const grid_level& g, const s
   struct solved_flow {
     double mach;
     steady_result st;
-    bool charged = false;  // its seconds are in rejected_seconds (an attempt there was rejected)
+    bool charged = false;  // its seconds were added to rejected_seconds (an attempt there was rejected)
+    // ... and a written point has taken them since: the steady solve stays booked as lost work
+    // even if a point at its (intermediate) Mach number is written later (conservative: then it
+    // is counted as both; taking it back would make that later point's hopf_seconds negative)
+    bool settled = false;
   };
   std::deque<solved_flow> flows;  // references stay valid as it grows
+  // cosine: structural_cosine to the previous point (NAN for the first point of the boundary;
+  // at a jump, to the last point of the ended branch)
+  auto write = [&](boundary_point p, double cosine) {
+    p.hopf_seconds += std::exchange(rejected_seconds, 0.0);
+    for (auto& f : flows) f.settled = f.settled || f.charged;
+    b.push_back(p);
+    csv.row({p.mach, p.ubar, p.omega, static_cast<long long>(p.newton_iterations),
+             static_cast<long long>(p.linear_iterations), p.hopf_seconds, p.steady_seconds});
+    std::printf("  %-6s %-8s M = %.4f  Ubar* = %.6f  omega* = %.6f  Newton %d  GMRES %5ld  hopf %.2f s  steady %.2f s  (ratio %.2f)  mode cosine %s\n",
+                c.name.c_str(), g.name.c_str(), p.mach, p.ubar, p.omega, p.newton_iterations, p.linear_iterations,
+                p.hopf_seconds, p.steady_seconds, p.hopf_seconds / p.steady_seconds,
+                std::isfinite(cosine) ? fixed(cosine, 3).c_str() : "-");
+    std::fflush(stdout);
+  };
   // Newton-Krylov from the two nearest solved flows; empty if it fails
   auto warm_flow = [&](const aerofoil_system& s, double m, double mu) -> vec<double> {
     std::vector<const solved_flow*> near;
@@ -522,11 +527,15 @@ boundary natural_boundary(const structural_case& c, const grid_level& g, const s
   };
   // charged = true: an attempt at m was rejected, its steady solve is lost work; false: a point
   // there is written after all
+  // A LISTED Mach number's steady solve is never charged: it is the unit of cost of the point
+  // written there in the end (a rejected attempt there is followed by one, unless the boundary
+  // stops early). Only intermediate Mach numbers' flows are lost work when an attempt is rejected.
   auto set_charged = [&](double m, bool charged) {
+    if (is_listed(machs, m)) return;
     for (auto& f : flows)
       if (std::abs(f.mach - m) < 1e-12 && f.charged != charged) {
-        rejected_seconds += charged ? f.st.seconds : -f.st.seconds;
-        f.charged = charged;
+        if (!f.settled) rejected_seconds += charged ? f.st.seconds : -f.st.seconds;
+        f.charged = charged;  // once settled, a flow's steady solve is booked for good (see solved_flow)
       }
   };
   // Grid sequencing at a listed Mach number where the start from the previous point failed:
