@@ -547,6 +547,17 @@ boundary natural_boundary(const structural_case& c, const grid_level& g, const s
   // decide). Tried once per Mach number (the result is kept; a second failure of the start from
   // the previous point there reuses it at no cost: its time was charged the first time). Where
   // it fails too, the step halving and the arclength hand-over go on as before.
+  // The coarser boundary's point at Mach number m as a start on this grid (its Ubar*, omega*,
+  // the eigenvector prolonged); none if the coarser boundary has no point there.
+  auto coarse_guess = [&](const aerofoil_system& s, double m) -> std::optional<hopf_point> {
+    const auto cp = std::find_if(coarser->begin(), coarser->end(),
+                                 [&](const boundary_point& q) { return std::abs(q.mach - m) < 1e-9; });
+    if (cp == coarser->end()) return std::nullopt;
+    const auto sc = make_system({"coarser", g.stride * coarser_ratio}, m, c.mu_s);
+    hopf_point guess = cp->point;
+    guess.p = s.prolong_from<cplx>(sc, coarser_ratio, cp->point.p);
+    return guess;
+  };
   std::map<double, std::optional<boundary_point>> restarts;
   auto coarse_restart = [&](const aerofoil_system& s, double m, const steady_result& st,
                             const std::string& label) -> std::optional<boundary_point> {
@@ -558,16 +569,12 @@ boundary natural_boundary(const structural_case& c, const grid_level& g, const s
                   q.omega);
       return q;
     }
-    const auto cp = std::find_if(coarser->begin(), coarser->end(),
-                                 [&](const boundary_point& q) { return std::abs(q.mach - m) < 1e-9; });
-    if (cp == coarser->end()) return std::nullopt;
     const auto t0 = clk::now();
-    const auto sc = make_system({"coarser", g.stride * coarser_ratio}, m, c.mu_s);
-    hopf_point guess = cp->point;
-    guess.p = s.prolong_from<cplx>(sc, coarser_ratio, cp->point.p);
-    std::printf("    %s: restart from the coarse-grid point (Ubar* = %.6f, omega* = %.6f)\n", label.c_str(), cp->ubar,
-                cp->omega);
-    auto q = hopf_at(s, m, st, guess, fill, label + " (coarse-grid restart)");
+    const std::optional<hopf_point> guess = coarse_guess(s, m);
+    if (!guess) return std::nullopt;
+    std::printf("    %s: restart from the coarse-grid point (Ubar* = %.6f, omega* = %.6f)\n", label.c_str(), guess->mu,
+                guess->omega);
+    auto q = hopf_at(s, m, st, *guess, fill, label + " (coarse-grid restart)");
     if (q) q->hopf_seconds = seconds_since(t0);
     restarts[m] = q;
     return q;
@@ -615,12 +622,9 @@ boundary natural_boundary(const structural_case& c, const grid_level& g, const s
           }
         }
       } else if (coarser) {  // grid sequencing from the coarser boundary at this Mach number
-        const auto it = std::find_if(coarser->begin(), coarser->end(),
-                                     [&](const boundary_point& p) { return std::abs(p.mach - m) < 1e-9; });
-        require(it != coarser->end(), "no coarse-grid point at M = ", m, " to start the finer grid from");
-        const auto sc = make_system({"coarser", g.stride * coarser_ratio}, m, c.mu_s);
-        guess = it->point;
-        guess.p = s.prolong_from<cplx>(sc, coarser_ratio, it->point.p);
+        auto cg = coarse_guess(s, m);
+        require(cg.has_value(), "no coarse-grid point at M = ", m, " to start the finer grid from");
+        guess = std::move(*cg);
       } else {
         guess = krylov_start(s, st.w, c.ubar_guess, c.omega_guess, fill);
         guess.mu = c.ubar_guess;
