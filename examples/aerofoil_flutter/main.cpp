@@ -31,6 +31,13 @@
 //   --coarse-restart on|off     where the start from the previous boundary point fails at a listed
 //                               Mach number, restart from the coarser grid's point there before
 //                               halving the step (default on; finer grids of a multi-grid run only)
+//   --coarse-guided-restart on|off  restart from the coarser grid's point BEFORE the start from the
+//                               previous point where the coarser boundary changes mode and its branch
+//                               ends within 1/4 of the listed step (default on)
+//   --coarse-predictor off|values|full|auto  predict Ubar*, omega* (values) and the eigenvector
+//                               (full) from the previous point plus the coarser boundary's increment
+//                               between the two Mach numbers; auto (default): the eigenvector only
+//                               where the secant one's Hopf residual exceeds the refinement threshold
 //   --tracer-max-step s         largest arclength step of the hand-over, in its metric (default 1)
 //   --tracer-dw-tol t           GMRES tolerance of dw0/dnu in the arclength hand-over
 //                               (symmetric_hopf_curve_options::derivative_tolerance)
@@ -150,12 +157,24 @@ bool start_reorthogonalize = false;  // --start-gram-schmidt once|twice: ... of 
 /// then changes by < 1e-9 relative in a further iteration (light case, M = 0.6: 3e-10 from
 /// ||F|| = 6.6e-8), far below the grid error (1-3 %),
 /// and the last, most expensive Newton step (GMRES to 1e-5) is saved. The very coarse check
-/// and the reduced model keep 1e-10.
+/// and the reduced model keep 1e-10. That one case is not the rule: ||F|| <= 1e-7 fixes Ubar*
+/// only to about 2e-5 relative on the heavy medium boundary (Ubar* enters only through the
+/// structural stiffness, so dF/dUbar is small). Measured there: two runs with different
+/// predictors differ by up to 1.7e-5 (M = 0.82: 4.184011 at ||F|| = 8.6e-8, 4.184081 at
+/// 1.0e-8), and by 1.6e-5 from a run to 1e-9, which costs 14 % more (0.86 -> 0.98 steady solves
+/// per listed Mach number).
 double boundary_tolerance = 1e-7;
 bool tracer_joint = true;  // --tracer-corrector joint|nested: symmetric_hopf_curve_options::joint_equilibrium
 double tracer_max_step = 0;  // --tracer-max-step: hopf_curve_options::max_step of the hand-over (0: 1.0)
 bool jump_search_bottom = true;  // --jump-search bottom|top: natural_boundary's search after an other-mode point
 bool use_coarse_restart = true;  // --coarse-restart on|off: natural_boundary's grid-sequenced restart
+bool coarse_guided_restart = true;  // --coarse-guided-restart on|off: natural_boundary's restart BEFORE the start
+                                    // from the previous point where the coarser boundary changes mode
+double start_residual_threshold = 10.0;  // hopf_krylov_options::start_residual_threshold of hopf_at: subsonic
+                                        // continued guesses (||F|| 3-7) go straight to Newton
+int coarse_predictor = 3;  // --coarse-predictor off|values|full|auto: natural_boundary's predictor from the
+                           // coarser boundary's increments (0 off; 1 Ubar and omega; 2 also the eigenvector;
+                           // 3 Ubar and omega, and the eigenvector where the secant one is far off)
 double tracer_derivative_tolerance = 0;  // --tracer-dw-tol: symmetric_hopf_curve_options::derivative_tolerance
                                          // of the hand-over (0: aerofoil_tracer_options' value)
 
@@ -254,7 +273,7 @@ std::optional<boundary_point> hopf_at(const aerofoil_system& s, double mach, con
   ko.reuse_window = 2e-2;
   ko.start_iterations = start_iterations;
   ko.start_tolerance = start_tolerance;
-  ko.start_residual_threshold = 10.0;  // subsonic continued guesses (||F|| 3-7) go straight to Newton
+  ko.start_residual_threshold = start_residual_threshold;
   ko.krylov.restart = hopf_restart;
   ko.forcing_exponent = hopf_forcing;
   ko.krylov.reorthogonalize = hopf_reorthogonalize;
@@ -558,6 +577,13 @@ boundary natural_boundary(const structural_case& c, const grid_level& g, const s
     guess.p = s.prolong_from<cplx>(sc, coarser_ratio, cp->point.p);
     return guess;
   };
+  // the coarser boundary's point at Mach number m, if it has one
+  auto coarse_at = [&](double m) -> const boundary_point* {
+    if (!coarser) return nullptr;
+    const auto cp = std::find_if(coarser->begin(), coarser->end(),
+                                 [&](const boundary_point& q) { return std::abs(q.mach - m) < 1e-9; });
+    return cp == coarser->end() ? nullptr : &*cp;
+  };
   std::map<double, std::optional<boundary_point>> restarts;
   auto coarse_restart = [&](const aerofoil_system& s, double m, const steady_result& st,
                             const std::string& label) -> std::optional<boundary_point> {
@@ -595,7 +621,36 @@ boundary natural_boundary(const structural_case& c, const grid_level& g, const s
       hopf_point guess;
       const std::string label = c.name + " " + g.name + " M=" + fixed(m, 4);
       const auto t0 = clk::now();
-      if (!b.empty()) {
+      // Coarse-guided restart: at the first attempt of a listed step across which the coarser
+      // boundary changes mode AND its branch ends within 1/4 of the step (its last point of the
+      // mode it has at m_done lies below m_done + step/4), the start from the previous point is
+      // skipped: the coarse-grid restart is solved at once, and where it finds the other mode the
+      // jump search starts from the bottom (1/8 of the step), as after a start that converged to
+      // the other mode. Measured, heavy medium M = 0.90 -> 0.91 (coarse branch to 0.90125): the
+      // start from the previous point took 7 Newton iterations to reach the other mode, the
+      // restart 3. Where the coarser branch goes on past step/4 the finer one may go on too
+      // (heavy M = 0.82 -> 0.83: coarse to 0.8267, medium to 0.8259) or not (light M = 0.90 -> 0.91:
+      // coarse to 0.90625, medium to below 0.90125), and the start from the previous point decides
+      // as before.
+      bool preempted = false;
+      if (coarse_guided_restart && use_coarse_restart && coarser && !b.empty() && std::abs(m - mach) < 1e-12 &&
+          std::abs(b.back().mach - m_done) < 1e-12 && is_listed(machs, m)) {
+        const boundary_point* c0 = coarse_at(m_done);
+        const boundary_point* c1 = coarse_at(m);
+        if (c0 && c1 && structural_cosine(c0->point.p, c1->point.p) < same_mode_cosine) {
+          double m_end = m_done;  // the coarser boundary's last point of c0's mode before m
+          for (const auto& q : *coarser)
+            if (q.mach > m_done + 1e-9 && q.mach < m - 1e-9 && structural_cosine(c0->point.p, q.point.p) >= same_mode_cosine)
+              m_end = std::max(m_end, q.mach);
+          preempted = m_end - m_done < 0.25 * full_step + 1e-12;
+          if (preempted)
+            std::printf("    %s: the coarser boundary's branch ends at M = %.5f and it changes mode before M = %.4f: "
+                        "restart from its point first\n",
+                        label.c_str(), m_end, m);
+        }
+      }
+      if (preempted) {
+      } else if (!b.empty()) {
         guess = b.back().point;
         // secant predictor in M for Ubar, omega and the eigenvector, over a base no shorter than
         // a tenth of the step: after an arclength stretch the last two points can lie 4e-5 apart
@@ -621,6 +676,53 @@ boundary natural_boundary(const structural_case& c, const grid_level& g, const s
             guess.p = p2.point.p + t * (p2.point.p - q1);
           }
         }
+        // Coarse-grid increment predictor (finer grid of a multi-grid run, where the coarser
+        // boundary has points of one mode at both Mach numbers): Ubar* and omega* of the previous
+        // point plus the coarser boundary's change between the two Mach numbers. The transonic
+        // boundary wiggles as shocks cross cells, the same way on both grids (heavy case,
+        // M 0.87 -> 0.88: coarse -0.513, medium -0.524 in Ubar*), which no secant through the
+        // last two points can follow. The eigenvector likewise: the previous one plus the
+        // prolonged coarse-grid change (see coarse_predictor for when it is used). Measured on the
+        // heavy medium boundary: 89 -> 61-71 Newton iterations over its 23 points.
+        if (coarser && coarse_predictor > 0) {
+          const auto c0 = coarse_at(b.back().mach), c1 = coarse_at(m);
+          if (c0 && c1 && structural_cosine(c0->point.p, c1->point.p) >= same_mode_cosine) {
+            const boundary_point& p2 = b.back();
+            guess.mu = p2.ubar + (c1->ubar - c0->ubar);
+            guess.omega = p2.omega + (c1->omega - c0->omega);
+            if (coarse_predictor > 1) {
+              Eigen::Index kc = 0, k = 0;
+              c0->point.p.cwiseAbs().maxCoeff(&kc);
+              p2.point.p.cwiseAbs().maxCoeff(&k);
+              const auto sc = make_system({"coarser", g.stride * coarser_ratio}, m, c.mu_s);
+              const vec<cplx> d = c1->point.p * (c0->point.p[kc] / c1->point.p[kc]) - c0->point.p;
+              const vec<cplx> q0 = s.prolong_from<cplx>(sc, coarser_ratio, c0->point.p);
+              if (std::abs(q0[k]) > 0) {
+                hopf_point alt = guess;  // the eigenvector from the coarser increment
+                alt.p = p2.point.p + (p2.point.p[k] / q0[k]) * s.prolong_from<cplx>(sc, coarser_ratio, d);
+                bool use_alt = coarse_predictor == 2;
+                if (coarse_predictor == 3) {
+                  // auto: the secant eigenvector where its Hopf residual at the predicted Ubar, omega is
+                  // small enough for Newton without the start refinement (hopf_at's threshold 10:
+                  // subsonic, ||F|| 3-6), the coarser increment where it is not (its ||F|| is 20-660,
+                  // from the prolonged coarse-grid flow part, but one inverse iteration takes it to
+                  // 3e-4 .. 5e-2, against 2e-2 .. 6e-1 from the secant one)
+                  hopf_point h = guess;
+                  h.w = st.w;
+                  vec<double> y;
+                  const aerohopf::internal::symmetric_hopf_problem<aerofoil_system> pr(
+                      s, h, hopf_opts(label + " predictor", boundary_tolerance), "predictor", y);
+                  const double f_secant = pr.residual(y).norm();
+                  use_alt = !(f_secant <= start_residual_threshold);
+                  if (verbose_newton)
+                    std::printf("    %s: predictor ||F|| %.3e with the secant eigenvector: %s\n", label.c_str(), f_secant,
+                                use_alt ? "the coarser increment's instead" : "kept");
+                }
+                if (use_alt) guess.p = std::move(alt.p);
+              }
+            }
+          }
+        }
       } else if (coarser) {  // grid sequencing from the coarser boundary at this Mach number
         auto cg = coarse_guess(s, m);
         require(cg.has_value(), "no coarse-grid point at M = ", m, " to start the finer grid from");
@@ -630,7 +732,7 @@ boundary natural_boundary(const structural_case& c, const grid_level& g, const s
         guess.mu = c.ubar_guess;
       }
       const double start_seconds = seconds_since(t0);
-      auto p = hopf_at(s, m, st, guess, fill, label);
+      auto p = preempted ? std::nullopt : hopf_at(s, m, st, guess, fill, label);
       auto t_attempt = t0;  // start of the attempt whose time a failure charges to rejected_seconds
       if (p) p->hopf_seconds += start_seconds;
       const bool restarted = !p && use_coarse_restart && coarser && !b.empty() && is_listed(machs, m);
@@ -722,7 +824,7 @@ boundary natural_boundary(const structural_case& c, const grid_level& g, const s
       // of the step at two (light and heavy medium, M = 0.90 -> 0.91) and between 1/8 and 1/4 at
       // the third (heavy coarse). Where the start FAILED, the step is halved (the branch may go on
       // close below m: heavy medium M = 0.83, whose branch continues to 0.825).
-      if (jump_search_bottom && !restarted && !others.empty() && std::abs(others.back().mach - m) < 1e-12 &&
+      if (jump_search_bottom && (!restarted || preempted) && !others.empty() && std::abs(others.back().mach - m) < 1e-12 &&
           step > 0.5 * full_step) {
         step = full_step / 8.0;
         std::cout << "    the other mode at the full step: retrying with the smallest Mach step " << step << "\n";
@@ -1319,6 +1421,15 @@ int main(int argc, char** argv) {
         const std::string v = next();
         require(v == "bottom" || v == "top", "--jump-search takes bottom or top, not ", v);
         jump_search_bottom = v == "bottom";
+      } else if (a == "--coarse-guided-restart") {
+        const std::string v = next();
+        require(v == "on" || v == "off", "--coarse-guided-restart takes on or off, not ", v);
+        coarse_guided_restart = v == "on";
+      } else if (a == "--coarse-predictor") {
+        const std::string v = next();
+        require(v == "off" || v == "values" || v == "full" || v == "auto",
+                "--coarse-predictor takes off, values, full or auto, not ", v);
+        coarse_predictor = v == "off" ? 0 : v == "values" ? 1 : v == "full" ? 2 : 3;
       } else if (a == "--coarse-restart") {
         const std::string v = next();
         require(v == "on" || v == "off", "--coarse-restart takes on or off, not ", v);
@@ -1391,6 +1502,28 @@ int main(int argc, char** argv) {
           csv.row({key, std::string(""), std::string("hopf_per_steady_listed"), (hopf + extra) / st_listed});
         }
       }
+      // A finer boundary of a multi-grid run starts from the coarser one and uses it (restarts,
+      // predictor): the same figure with the coarser boundary's whole wall time (every steady
+      // solve and all its Hopf work) charged too, in the finer grid's listed steady solves.
+      if (o.method == "natural")
+        for (const auto& c : o.cases)
+          for (std::size_t i = 1; i < o.grids.size(); ++i) {
+            if (o.grids[i - 1].stride != 2 * o.grids[i].stride) continue;
+            const auto fine = all.find(c.name + "_" + o.grids[i].name), coarse = all.find(c.name + "_" + o.grids[i - 1].name);
+            if (fine == all.end() || coarse == all.end() || fine->second.size() < 2) continue;
+            double work = 0, st_listed = 0, coarse_work = 0;
+            for (std::size_t k = 1; k < fine->second.size(); ++k) {
+              const boundary_point& q = fine->second[k];
+              work += q.hopf_seconds;
+              if (is_listed(listed, q.mach)) st_listed += q.steady_seconds;
+              else if (q.own_steady) work += q.steady_seconds;
+            }
+            for (const boundary_point& q : coarse->second) coarse_work += q.hopf_seconds + (q.own_steady ? q.steady_seconds : 0.0);
+            std::printf("  %-22s all Hopf work + the whole %s boundary / steady solve = %.2f (per listed Mach number)\n",
+                        fine->first.c_str(), o.grids[i - 1].name.c_str(), (work + coarse_work) / st_listed);
+            csv.row({fine->first, std::string(""), std::string("hopf_and_coarser_per_steady_listed"),
+                     (work + coarse_work) / st_listed});
+          }
       for (double r : march_costs) {
         std::printf("  time-marching run (4 cycles) / steady solve = %.1f\n", r);
         csv.row({std::string("light"), o.verify_grid.name, std::string("march_per_steady"), r});
