@@ -650,6 +650,8 @@ boundary natural_boundary(const structural_case& c, const grid_level& g, const s
         }
       }
       if (preempted) {
+        // no start from the previous point: the coarse-grid restart below is this attempt (and
+        // the first-point branches further down must not run: b is not empty)
       } else if (!b.empty()) {
         guess = b.back().point;
         // secant predictor in M for Ubar, omega and the eigenvector, over a base no shorter than
