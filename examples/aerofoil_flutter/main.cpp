@@ -568,21 +568,20 @@ boundary natural_boundary(const structural_case& c, const grid_level& g, const s
   // it fails too, the step halving and the arclength hand-over go on as before.
   // The coarser boundary's point at Mach number m as a start on this grid (its Ubar*, omega*,
   // the eigenvector prolonged); none if the coarser boundary has no point there.
-  auto coarse_guess = [&](const aerofoil_system& s, double m) -> std::optional<hopf_point> {
-    const auto cp = std::find_if(coarser->begin(), coarser->end(),
-                                 [&](const boundary_point& q) { return std::abs(q.mach - m) < 1e-9; });
-    if (cp == coarser->end()) return std::nullopt;
-    const auto sc = make_system({"coarser", g.stride * coarser_ratio}, m, c.mu_s);
-    hopf_point guess = cp->point;
-    guess.p = s.prolong_from<cplx>(sc, coarser_ratio, cp->point.p);
-    return guess;
-  };
   // the coarser boundary's point at Mach number m, if it has one
   auto coarse_at = [&](double m) -> const boundary_point* {
     if (!coarser) return nullptr;
     const auto cp = std::find_if(coarser->begin(), coarser->end(),
                                  [&](const boundary_point& q) { return std::abs(q.mach - m) < 1e-9; });
     return cp == coarser->end() ? nullptr : &*cp;
+  };
+  auto coarse_guess = [&](const aerofoil_system& s, double m) -> std::optional<hopf_point> {
+    const boundary_point* cp = coarse_at(m);
+    if (!cp) return std::nullopt;
+    const auto sc = make_system({"coarser", g.stride * coarser_ratio}, m, c.mu_s);
+    hopf_point guess = cp->point;
+    guess.p = s.prolong_from<cplx>(sc, coarser_ratio, cp->point.p);
+    return guess;
   };
   std::map<double, std::optional<boundary_point>> restarts;
   auto coarse_restart = [&](const aerofoil_system& s, double m, const steady_result& st,
@@ -692,36 +691,33 @@ boundary natural_boundary(const structural_case& c, const grid_level& g, const s
             const boundary_point& p2 = b.back();
             guess.mu = p2.ubar + (c1->ubar - c0->ubar);
             guess.omega = p2.omega + (c1->omega - c0->omega);
-            if (coarse_predictor > 1) {
+            // the eigenvector from the coarser increment: always (full), never (values), or (auto)
+            // where the secant eigenvector's Hopf residual at the predicted Ubar, omega is too large
+            // for Newton without the start refinement (hopf_at's threshold 10: subsonic secant
+            // guesses have ||F|| 3-6); the coarser increment's ||F|| is 20-660, from the prolonged
+            // coarse-grid flow part, but one inverse iteration takes it to 3e-4 .. 5e-2, against
+            // 2e-2 .. 6e-1 from the secant one
+            bool use_increment = coarse_predictor == 2;
+            if (coarse_predictor == 3) {
+              hopf_point h = guess;
+              h.w = st.w;
+              vec<double> y;
+              const aerohopf::internal::symmetric_hopf_problem<aerofoil_system> pr(
+                  s, h, hopf_opts(label + " predictor", boundary_tolerance), "predictor", y);
+              const double f_secant = pr.residual(y).norm();
+              use_increment = !(f_secant <= start_residual_threshold);
+              if (verbose_newton)
+                std::printf("    %s: predictor ||F|| %.3e with the secant eigenvector: %s\n", label.c_str(), f_secant,
+                            use_increment ? "the coarser increment's instead" : "kept");
+            }
+            if (use_increment) {
               Eigen::Index kc = 0, k = 0;
               c0->point.p.cwiseAbs().maxCoeff(&kc);
               p2.point.p.cwiseAbs().maxCoeff(&k);
               const auto sc = make_system({"coarser", g.stride * coarser_ratio}, m, c.mu_s);
               const vec<cplx> d = c1->point.p * (c0->point.p[kc] / c1->point.p[kc]) - c0->point.p;
               const vec<cplx> q0 = s.prolong_from<cplx>(sc, coarser_ratio, c0->point.p);
-              if (std::abs(q0[k]) > 0) {
-                hopf_point alt = guess;  // the eigenvector from the coarser increment
-                alt.p = p2.point.p + (p2.point.p[k] / q0[k]) * s.prolong_from<cplx>(sc, coarser_ratio, d);
-                bool use_alt = coarse_predictor == 2;
-                if (coarse_predictor == 3) {
-                  // auto: the secant eigenvector where its Hopf residual at the predicted Ubar, omega is
-                  // small enough for Newton without the start refinement (hopf_at's threshold 10:
-                  // subsonic, ||F|| 3-6), the coarser increment where it is not (its ||F|| is 20-660,
-                  // from the prolonged coarse-grid flow part, but one inverse iteration takes it to
-                  // 3e-4 .. 5e-2, against 2e-2 .. 6e-1 from the secant one)
-                  hopf_point h = guess;
-                  h.w = st.w;
-                  vec<double> y;
-                  const aerohopf::internal::symmetric_hopf_problem<aerofoil_system> pr(
-                      s, h, hopf_opts(label + " predictor", boundary_tolerance), "predictor", y);
-                  const double f_secant = pr.residual(y).norm();
-                  use_alt = !(f_secant <= start_residual_threshold);
-                  if (verbose_newton)
-                    std::printf("    %s: predictor ||F|| %.3e with the secant eigenvector: %s\n", label.c_str(), f_secant,
-                                use_alt ? "the coarser increment's instead" : "kept");
-                }
-                if (use_alt) guess.p = std::move(alt.p);
-              }
+              if (std::abs(q0[k]) > 0) guess.p = p2.point.p + (p2.point.p[k] / q0[k]) * s.prolong_from<cplx>(sc, coarser_ratio, d);
             }
           }
         }
@@ -1476,21 +1472,28 @@ int main(int argc, char** argv) {
       csv_writer csv(o.out / "costs.csv", "case,grid,quantity,ratio_to_steady");
       std::cout << "\n=== cost per unit steady solve (same run, same machine) ===\n";
       const std::vector<double> listed = mach_list(o);
-      for (const auto& [key, b] : all) {
-        // the first point includes the inverse-power start; the others are continued. hopf_seconds
-        // include the rejected attempts before each point and the whole arclength stretches.
+      // over the continued points (the first includes the inverse-power start; hopf_seconds
+      // include the rejected attempts before each point and the whole arclength stretches)
+      struct continued_cost {
         double hopf = 0, st = 0, extra = 0, st_listed = 0;
         std::size_t n_listed = 0;
+      };
+      auto cost_of = [&](const boundary& b) {
+        continued_cost r;
         for (std::size_t k = 1; k < b.size(); ++k) {
-          hopf += b[k].hopf_seconds;
-          st += b[k].steady_seconds;
+          r.hopf += b[k].hopf_seconds;
+          r.st += b[k].steady_seconds;
           if (is_listed(listed, b[k].mach)) {
-            st_listed += b[k].steady_seconds;
-            ++n_listed;
+            r.st_listed += b[k].steady_seconds;
+            ++r.n_listed;
           } else if (b[k].own_steady) {
-            extra += b[k].steady_seconds;  // a steady solve at an intermediate Mach number
+            r.extra += b[k].steady_seconds;  // a steady solve at an intermediate Mach number
           }
         }
+        return r;
+      };
+      for (const auto& [key, b] : all) {
+        const auto [hopf, st, extra, st_listed, n_listed] = cost_of(b);
         if (b.size() > 1) {
           std::printf("  %-22s Hopf point / steady solve = %.2f (mean over %zu continued points)\n", key.c_str(),
                       hopf / st, b.size() - 1);
@@ -1513,18 +1516,14 @@ int main(int argc, char** argv) {
             if (o.grids[i - 1].stride != 2 * o.grids[i].stride) continue;
             const auto fine = all.find(c.name + "_" + o.grids[i].name), coarse = all.find(c.name + "_" + o.grids[i - 1].name);
             if (fine == all.end() || coarse == all.end() || fine->second.size() < 2) continue;
-            double work = 0, st_listed = 0, coarse_work = 0;
-            for (std::size_t k = 1; k < fine->second.size(); ++k) {
-              const boundary_point& q = fine->second[k];
-              work += q.hopf_seconds;
-              if (is_listed(listed, q.mach)) st_listed += q.steady_seconds;
-              else if (q.own_steady) work += q.steady_seconds;
-            }
+            const continued_cost f = cost_of(fine->second);
+            if (f.n_listed == 0) continue;
+            double coarse_work = 0;
             for (const boundary_point& q : coarse->second) coarse_work += q.hopf_seconds + (q.own_steady ? q.steady_seconds : 0.0);
+            const double ratio = (f.hopf + f.extra + coarse_work) / f.st_listed;
             std::printf("  %-22s all Hopf work + the whole %s boundary / steady solve = %.2f (per listed Mach number)\n",
-                        fine->first.c_str(), o.grids[i - 1].name.c_str(), (work + coarse_work) / st_listed);
-            csv.row({fine->first, std::string(""), std::string("hopf_and_coarser_per_steady_listed"),
-                     (work + coarse_work) / st_listed});
+                        fine->first.c_str(), o.grids[i - 1].name.c_str(), ratio);
+            csv.row({fine->first, std::string(""), std::string("hopf_and_coarser_per_steady_listed"), ratio});
           }
       for (double r : march_costs) {
         std::printf("  time-marching run (4 cycles) / steady solve = %.1f\n", r);

@@ -30,7 +30,7 @@ head -1 "$a" | grep -qx "mach,ubar,omega,newton_iterations,linear_iterations,hop
 # the 17 listed Mach numbers (0.75, 0.80, 0.81 .. 0.95): every one in both files, equal to 1e-4
 awk -F, '
   FNR == 1 { next }
-  { key = sprintf("%.5f", $1); listed = (key == "0.75000" || key == "0.80000" || (key + 0 > 0.805 && (key * 100) % 1 < 1e-6)) }
+  { key = sprintf("%.5f", $1); c = key * 100; listed = (key == "0.75000" || key == "0.80000" || (key + 0 > 0.805 && (c - int(c + 0.5)) ^ 2 < 1e-12)) }
   !listed { next }
   FNR == NR { ub[key] = $2; om[key] = $3; next }
   {
