@@ -247,7 +247,8 @@ struct byte_cursor {
   bool swapped = false;
   std::size_t pos = 0;
 
-  std::size_t remaining() const { return bytes.size() - pos; }
+  /// Bytes after pos; 0 (not a wrapped difference) if pos has been set past the end.
+  std::size_t remaining() const { return pos < bytes.size() ? bytes.size() - pos : 0; }
   template <class T>
   bool get(T& v) {
     if (remaining() < sizeof(T)) return false;
