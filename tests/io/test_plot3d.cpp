@@ -360,7 +360,7 @@ TEST(plot3d, dimension_counts_and_lengths_are_checked) {
   o = read_outcome<2>(fortran_file<3>(g3, true));
   EXPECT_TRUE(mentions(o, "3D file read as 2D")) << o.message;
   // block counts <= 0 or absurd, sizes <= 1, in text and binary
-  for (const std::string content : {"0\n", "-3\n2 2\n", "2147483648\n2 2\n", "99999999999999999999999\n",
+  for (const std::string content : {"0\n", "-3\n2 2\n", "2147483648\n2 2\n", "6666666667666666666\n2 2\n", "99999999999999999999999\n",
                                     "1\n-2 2\n0 1 0 1\n", "1\n2 0\n", "1\n2 2.5\n0 1 0 1 0 0 1 1\n"}) {
     o = read_outcome<2>(content);
     EXPECT_EQ(o.kind, outcome::input) << content << ": " << o.message;

@@ -175,8 +175,8 @@ flow::multiblock_points<double, Dim> read_ascii(std::string_view text, const std
           "' is not a positive number of blocks");
   // Every block size is a token of at least one character after at least one separator.
   require(static_cast<unsigned long long>(nb) <= in.remaining() / (2 * Dim), file, ": ", nb,
-          " blocks claimed, but the ", in.remaining(), " bytes after the block count cannot hold their ", Dim * nb,
-          " sizes");
+          " blocks claimed, but the ", in.remaining(), " bytes after the block count cannot hold their ", Dim,
+          " sizes each");
   std::vector<flow::index_d<Dim>> dims(static_cast<std::size_t>(nb));
   for (std::size_t b = 0; b < dims.size(); ++b)
     for (int d = 0; d < Dim; ++d) {
@@ -208,17 +208,19 @@ flow::multiblock_points<double, Dim> read_ascii(std::string_view text, const std
     blk.x.resize(blk.n_points());
     for (int d = 0; d < Dim; ++d)
       for (std::size_t k = 0; k < blk.x.size(); ++k) {
+        // (messages are built only on failure: this loop runs once per coordinate)
         tok = in.next();
-        require(!tok.empty(), file, ": block ", b, ": the file ends at coordinate ", d, " of ",
-                point_text<Dim>(k, blk.points), " (truncated file or wrong sizes)");
+        if (tok.empty())
+          throw input_error(concat(file, ": block ", b, ": the file ends at coordinate ", d, " of ",
+                                   point_text<Dim>(k, blk.points), " (truncated file or wrong sizes)"));
         double& x = blk.x[k][d];
         const auto st = parse_real(tok, x);
-        require(st != real_status::not_a_number, file, ": block ", b, " ", point_text<Dim>(k, blk.points),
-                ": coordinate ", d, " '", printable(tok), "' (line ", in.line, ") is not a number");
-        require(st != real_status::out_of_range, file, ": block ", b, " ", point_text<Dim>(k, blk.points),
-                ": coordinate ", d, " '", printable(tok), "' (line ", in.line, ") is out of the range of double");
-        require(std::isfinite(x), file, ": block ", b, " ", point_text<Dim>(k, blk.points), ": coordinate ", d,
-                " is '", printable(tok), "' (line ", in.line, "), not a finite number");
+        if (st != real_status::ok || !std::isfinite(x))
+          throw input_error(concat(file, ": block ", b, " ", point_text<Dim>(k, blk.points), ": coordinate ", d, " '",
+                                   printable(tok), "' (line ", in.line, ") ",
+                                   st == real_status::not_a_number   ? "is not a number"
+                                   : st == real_status::out_of_range ? "is out of the range of double"
+                                                                     : "is not a finite number"));
       }
   }
   tok = in.next();
@@ -438,9 +440,11 @@ flow::multiblock_points<double, Dim> read_binary(std::string_view bytes, const s
           ok = c.get(f);
           x = f;
         }
-        require(ok, file, ": internal error: block ", b, " coordinates end early");
-        require(std::isfinite(x), file, ": block ", b, " ", point_text<Dim>(k, blk.points), ": coordinate ", d, " is ", x,
-                ", not a finite number");
+        // (messages are built only on failure: this loop runs once per coordinate)
+        if (!ok) throw input_error(concat(file, ": internal error: block ", b, " coordinates end early"));
+        if (!std::isfinite(x))
+          throw input_error(concat(file, ": block ", b, " ", point_text<Dim>(k, blk.points), ": coordinate ", d,
+                                   " is ", x, ", not a finite number"));
         blk.x[k][d] = x;
       }
     c.pos += static_cast<std::size_t>(best.layout.marker);
