@@ -76,13 +76,13 @@ concept has_jacobian_directional =
 template <system S>
 using jacobian_t = typename S::jacobian_type;
 
-/// Throws input_error if w has the wrong size or a non-finite entry (names the entry).
+/// Throws input_error if w has the wrong size or a non-finite entry (names the first one), or
+/// if mu is not finite.
 template <system S>
 void check_state(const S& s, const vec<double>& w, double mu, const char* who) {
-  require(w.size() == s.size(), who, ": state has ", w.size(), " entries, system has ", s.size());
-  require(std::isfinite(mu), who, ": parameter mu is not finite");
-  for (Eigen::Index i = 0; i < w.size(); ++i)
-    require(std::isfinite(w[i]), who, ": state entry ", i, " is not finite (", w[i], ")");
+  require_size(w.size(), s.size(), who, "state");
+  require(std::isfinite(mu), who, ": parameter mu is not finite (", mu, ")");
+  require_finite(w, who, "state");
 }
 
 /// The approximate (left-hand-side) Jacobian if the system has one, else the exact one.
