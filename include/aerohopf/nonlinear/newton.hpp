@@ -47,10 +47,8 @@
 #include <cmath>
 #include <functional>
 #include <iomanip>
-#include <exception>
 #include <limits>
 #include <iostream>
-#include <new>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -121,37 +119,6 @@ inline std::function<void(const newton_step_info&)> newton_progress(std::string 
 namespace internal {
 inline double norm_or_nan(const vec<double>& v) { return v.allFinite() ? v.norm() : NAN; }
 
-/// Inside a catch block: rethrows the exception being handled with `context` in front of its
-/// message, keeping its aerohopf type (a foreign std::exception becomes convergence_error;
-/// std::bad_alloc and non-std exceptions pass unchanged).
-[[noreturn]] inline void rethrow_with_context(const std::string& context) {
-  try {
-    throw;
-  } catch (const singular_matrix_error& e) {
-    throw singular_matrix_error(context + e.what());
-  } catch (const input_error& e) {
-    throw input_error(context + e.what());
-  } catch (const convergence_error& e) {
-    throw convergence_error(context + e.what());
-  } catch (const error& e) {
-    throw error(context + e.what());
-  } catch (const std::bad_alloc&) {
-    throw;
-  } catch (const std::exception& e) {
-    throw convergence_error(context + e.what());
-  }
-}
-
-/// The message of the exception being handled (inside a catch block).
-inline std::string current_exception_text() {
-  try {
-    throw;
-  } catch (const std::exception& e) {
-    return e.what();
-  } catch (...) {
-    return "unknown exception";
-  }
-}
 }  // namespace internal
 
 /// Throws input_error naming the option and its value unless every field of o is finite and

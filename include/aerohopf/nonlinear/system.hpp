@@ -28,6 +28,9 @@
 
 #include <cmath>
 #include <concepts>
+#include <exception>
+#include <new>
+#include <string>
 #include <type_traits>
 
 #include "../error.hpp"
@@ -75,6 +78,40 @@ concept has_jacobian_directional =
 
 template <system S>
 using jacobian_t = typename S::jacobian_type;
+
+namespace internal {
+/// Inside a catch block: rethrows the exception being handled with `context` in front of its
+/// message, keeping its aerohopf type (a foreign std::exception becomes convergence_error;
+/// std::bad_alloc and non-std exceptions pass unchanged).
+[[noreturn]] inline void rethrow_with_context(const std::string& context) {
+  try {
+    throw;
+  } catch (const singular_matrix_error& e) {
+    throw singular_matrix_error(context + e.what());
+  } catch (const input_error& e) {
+    throw input_error(context + e.what());
+  } catch (const convergence_error& e) {
+    throw convergence_error(context + e.what());
+  } catch (const error& e) {
+    throw error(context + e.what());
+  } catch (const std::bad_alloc&) {
+    throw;
+  } catch (const std::exception& e) {
+    throw convergence_error(context + e.what());
+  }
+}
+
+/// The message of the exception being handled (inside a catch block).
+inline std::string current_exception_text() {
+  try {
+    throw;
+  } catch (const std::exception& e) {
+    return e.what();
+  } catch (...) {
+    return "unknown exception";
+  }
+}
+}  // namespace internal
 
 /// Throws input_error if w has the wrong size or a non-finite entry (names the first one), or
 /// if mu is not finite.
