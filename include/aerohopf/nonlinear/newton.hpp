@@ -27,11 +27,12 @@
 // newton_options::describe gives them, and the original error text; an exception from inside
 // an iteration is rethrown with its own type (singular_matrix_error stays one; a foreign
 // std::exception becomes convergence_error, std::bad_alloc passes unchanged). The result's x is
-// the last accepted iterate, whose residual is finite, so a run can continue from it.
-// Input checks (input_error, before anything is evaluated): the options (finite, in range) and
-// a finite initial iterate.
-// Under-relaxation: steps are
-// scaled by `relaxation` until ||F|| has dropped below relax_until ||F_0||, then full steps
+// the last accepted iterate, whose residual is finite, so a run can continue from it. An
+// exception from the observer passes unchanged.
+// Input checks (input_error, before anything is evaluated): the options (finite, in range,
+// check_newton_options) and a finite initial iterate.
+// Under-relaxation: steps are scaled by `relaxation` until ||F|| has dropped below
+// relax_until ||F_0||, then full steps
 // (the start-up strategy reported for the augmented Hopf system); an optional backtracking
 // line search halves a step that does not decrease ||F||.
 // Contraction test (off by default): from iteration contraction_from on, an iteration whose
