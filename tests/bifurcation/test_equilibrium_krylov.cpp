@@ -150,3 +150,70 @@ TEST(equilibrium_krylov, aerofoil_next_mach_number_matches_pseudo_transient_solv
   const auto r2 = solve_equilibrium_krylov<4>(s1, 2.0, w0, o);
   EXPECT_LT((r2.w - r.w).lpNorm<Eigen::Infinity>(), 1e-9);
 }
+
+// ---- broken promises and fault injection (reliability) ----
+namespace {
+/// shifted_cubic_system with a residual that is NaN (entry 2) on call nan_call and an
+/// approximate Jacobian that is zero when zero_lhs (BILU breaks down).
+struct faulty_cubic {
+  using jacobian_type = Eigen::SparseMatrix<double>;
+  const shifted_cubic_system& s;
+  int nan_call = -1;
+  bool zero_lhs = false;
+  mutable int calls = 0;
+  Eigen::Index size() const { return s.size(); }
+  vec<double> residual(const vec<double>& w, double mu) const {
+    vec<double> f = s.residual(w, mu);
+    if (++calls == nan_call) f[2] = NAN;
+    return f;
+  }
+  jacobian_type jacobian(const vec<double>& w, double mu) const { return s.jacobian(w, mu); }
+  jacobian_type approximate_jacobian(const vec<double>& w, double mu) const {
+    jacobian_type a = s.approximate_jacobian(w, mu);
+    if (zero_lhs) a *= 0.0;
+    return a;
+  }
+};
+}  // namespace
+
+// newton.throw_on_failure = false is honoured: a NaN residual at iterate 2 is a result with
+// converged = false naming the label, the iterate, ||f|| and mu, w the last good iterate, from
+// which a second solve reaches the closed form. Thrown, a BILU breakdown stays
+// singular_matrix_error (with the label and the iterate in front).
+TEST(equilibrium_krylov, failures_honour_throw_on_failure_and_keep_the_last_good_iterate) {
+  const shifted_cubic_system sys(12);
+  vec<double> w0 = sys.equilibrium();
+  for (Eigen::Index i = 0; i < w0.size(); ++i) w0[i] += 0.3 * std::cos(1.3 * static_cast<double>(i));
+  const vec<double> w0_copy = w0;
+  equilibrium_krylov_options o;
+  o.fill_level = 0;
+  o.newton.abs_tolerance = 1e-13;
+  o.newton.line_search = false;
+  o.newton.throw_on_failure = false;
+  faulty_cubic f{sys};
+  f.nan_call = 3;  // the trial point of step 2
+  const auto r = solve_equilibrium_krylov<4>(f, 0.25, w0, o, "faulty cubic");
+  EXPECT_EQ(w0, w0_copy);
+  EXPECT_FALSE(r.report.converged);
+  EXPECT_NE(r.report.reason.find("faulty cubic: residual not finite at iterate 2"), std::string::npos) << r.report.reason;
+  EXPECT_NE(r.report.reason.find("mu = 0.25"), std::string::npos) << r.report.reason;
+  EXPECT_NE(r.report.reason.find(internal::concat("iterate 1 (||F|| = ", r.report.final_residual())), std::string::npos)
+      << r.report.reason;
+  ASSERT_TRUE(r.w.allFinite());
+  EXPECT_NEAR(sys.residual(r.w, 0.25).norm(), r.report.final_residual(), 1e-15);
+  o.newton.throw_on_failure = true;
+  const auto again = solve_equilibrium_krylov<4>(sys, 0.25, r.w, o);
+  ASSERT_TRUE(again.report.converged);
+  EXPECT_LT((again.w - sys.equilibrium()).lpNorm<Eigen::Infinity>(), 1e-13);
+
+  faulty_cubic z{sys};
+  z.zero_lhs = true;
+  try {
+    solve_equilibrium_krylov<4>(z, 0.25, w0, o, "zero preconditioner");
+    FAIL() << "expected singular_matrix_error";
+  } catch (const singular_matrix_error& e) {
+    EXPECT_NE(std::string(e.what()).find("zero preconditioner: step 1 from iterate 0"), std::string::npos) << e.what();
+  }
+  o.newton.relaxation = NAN;
+  EXPECT_THROW(solve_equilibrium_krylov<4>(sys, 0.25, w0, o), input_error);
+}

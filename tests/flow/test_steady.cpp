@@ -79,3 +79,130 @@ TEST(steady_solver, vortex_far_field_removes_domain_size_dependence) {
   EXPECT_GT(without, 0.01);
   EXPECT_LT(with, 0.3 * without) << cl[0][0] << " " << cl[0][1] << " " << cl[1][0] << " " << cl[1][1];
 }
+
+// ---- broken promises and fault injection (reliability) ----
+namespace {
+/// The model's residual with injected faults: NaN in entry 7 on residual call nan_from (and on
+/// every later call while persistent), an aerohopf::error thrown on call throw_call.
+struct faulty_residual {
+  const euler_model<2>& m;
+  int nan_from = -1, throw_call = -1;
+  bool persistent = false;
+  int* calls;
+  vec<double> operator()(const vec<double>& w) const {
+    const int c = ++*calls;
+    if (c == throw_call) throw error("faulty residual: refused");
+    vec<double> r = m.residual(w);
+    if (c == nan_from || (persistent && nan_from > 0 && c > nan_from)) r[7] = NAN;
+    return r;
+  }
+};
+bool has(const std::string& s, const std::string& part) { return s.find(part) != std::string::npos; }
+}  // namespace
+
+// One NaN residual (the trial state of step 3): the step is rejected and recorded (which step,
+// what was non-finite), the run goes on and reaches the uninjected answer.
+TEST(steady_solver, nan_residual_once_is_rejected_and_recorded) {
+  euler_model<2> m(coarsen(naca_cgrid(), 8), {.mach = 0.5, .alpha_rad = 0.02});
+  steady_options opt;
+  vec<double> clean = m.free_stream_vector();
+  ASSERT_TRUE(solve_steady<2>(m, clean, opt).converged);
+  int calls = 0;
+  vec<double> w = m.free_stream_vector();
+  const auto rep = solve_steady<2>(m, w, opt, faulty_residual{m, 4, -1, false, &calls});
+  EXPECT_TRUE(rep.converged) << rep.reason;
+  ASSERT_EQ(rep.rejections.size(), 1u);
+  EXPECT_TRUE(has(rep.rejections[0], "step 3: residual of the trial state not finite (entry 7")) << rep.rejections[0];
+  EXPECT_LT((w - clean).norm(), 1e-8 * clean.norm());
+}
+
+// A residual that stays NaN from the trial state of step 3 on: CFL_0 collapses; with
+// throw_on_failure = false the report says so (solve_steady, the step, ||R||, M, what was
+// non-finite), w is the last accepted state, and the run continues from it to the uninjected
+// answer. Thrown: the same message. An exception inside a step keeps its type and gets the
+// context.
+TEST(steady_solver, persistent_nan_residual_fails_clearly_and_keeps_the_last_good_state) {
+  euler_model<2> m(coarsen(naca_cgrid(), 8), {.mach = 0.5, .alpha_rad = 0.02});
+  steady_options opt;
+  vec<double> clean = m.free_stream_vector();
+  ASSERT_TRUE(solve_steady<2>(m, clean, opt).converged);
+  steady_options soft = opt;
+  soft.throw_on_failure = false;
+  int calls = 0;
+  vec<double> w = m.free_stream_vector();
+  const auto rep = solve_steady<2>(m, w, soft, faulty_residual{m, 4, -1, true, &calls});
+  EXPECT_FALSE(rep.converged);
+  EXPECT_EQ(rep.steps, 2);
+  EXPECT_TRUE(has(rep.reason, "solve_steady: CFL_0 collapsed")) << rep.reason;
+  EXPECT_TRUE(has(rep.reason, "residual of the trial state not finite (entry 7")) << rep.reason;
+  EXPECT_TRUE(has(rep.reason, "M = 0.5")) << rep.reason;
+  EXPECT_TRUE(has(rep.reason, aerohopf::internal::concat("||R||/sqrt(n) = ", rep.history.back().residual))) << rep.reason;
+  ASSERT_TRUE(w.allFinite());
+  EXPECT_TRUE(physical_state<2>(m, w));
+  EXPECT_NEAR(m.residual(w).norm() / std::sqrt(double(w.size())), rep.final_residual, 1e-14 * rep.initial_residual);
+  // continue from the last good state without the fault
+  ASSERT_TRUE(solve_steady<2>(m, w, opt).converged);
+  EXPECT_LT((w - clean).norm(), 1e-8 * clean.norm());
+
+  calls = 0;
+  vec<double> w2 = m.free_stream_vector();
+  try {
+    solve_steady<2>(m, w2, opt, faulty_residual{m, 4, -1, true, &calls});
+    FAIL() << "expected convergence_error";
+  } catch (const convergence_error& e) {
+    EXPECT_TRUE(has(e.what(), "CFL_0 collapsed")) << e.what();
+  }
+  calls = 0;
+  vec<double> w3 = m.free_stream_vector();
+  try {
+    solve_steady<2>(m, w3, opt, faulty_residual{m, -1, 3, false, &calls});
+    FAIL() << "expected an error";
+  } catch (const convergence_error&) {
+    FAIL() << "the type of the original error must be kept";
+  } catch (const error& e) {
+    EXPECT_TRUE(has(e.what(), "solve_steady: step 2 (")) << e.what();
+    EXPECT_TRUE(has(e.what(), "faulty residual: refused")) << e.what();
+  }
+  EXPECT_TRUE(physical_state<2>(m, w3));
+}
+
+// Options and the state are checked before anything is touched: input_error naming the option
+// or the first non-finite entry.
+TEST(steady_solver, rejects_bad_options_and_nan_state_naming_them) {
+  euler_model<2> m(coarsen(naca_cgrid(), 8), {.mach = 0.5});
+  const vec<double> w0 = m.free_stream_vector();
+  auto refused = [&](steady_options o, const char* name) {
+    vec<double> w = w0;
+    try {
+      solve_steady<2>(m, w, o);
+      ADD_FAILURE() << "expected input_error for " << name;
+    } catch (const input_error& e) {
+      EXPECT_TRUE(has(e.what(), name)) << e.what();
+    }
+    EXPECT_EQ(w, w0);
+  };
+  steady_options o;
+  o.cfl_initial = NAN;
+  refused(o, "cfl_initial");
+  o = {};
+  o.residual_drop = NAN;
+  refused(o, "residual_drop");
+  o = {};
+  o.linear_tolerance = 0;
+  refused(o, "linear_tolerance");
+  o = {};
+  o.ser_exponent = NAN;
+  refused(o, "ser_exponent");
+  o = {};
+  o.max_steps = -1;
+  refused(o, "max_steps");
+  vec<double> w = w0;
+  w[5] = NAN;
+  try {
+    solve_steady<2>(m, w);
+    FAIL() << "expected input_error";
+  } catch (const input_error& e) {
+    EXPECT_TRUE(has(e.what(), "state entry 5")) << e.what();
+  }
+  EXPECT_TRUE(std::isnan(w[5]));
+}

@@ -177,3 +177,229 @@ TEST(newton, ContractionTestLeavesContractingIterationsAlone) {
   EXPECT_EQ(stopped.report.iterations, 2);
   EXPECT_NE(stopped.report.reason.find("not contracting at iterate 2"), std::string::npos) << stopped.report.reason;
 }
+
+// ---- broken promises and fault injection (reliability) ----
+namespace {
+/// The tubular reactor with injected faults: the residual returns NaN in entry 3 on call
+/// nan_call (1-based count of residual calls), throws on call throw_call, and the Jacobian is
+/// the zero matrix on call zero_jacobian_call. -1: no fault.
+struct faulty_reactor {
+  using jacobian_type = tubular_reactor::jacobian_type;
+  const tubular_reactor& r;
+  int nan_call = -1, throw_call = -1, zero_jacobian_call = -1;
+  mutable int calls = 0, jacobian_calls = 0;
+  Eigen::Index size() const { return r.size(); }
+  vec<double> residual(const vec<double>& w, double mu) const {
+    ++calls;
+    if (calls == throw_call) throw error("faulty_reactor: refused state");
+    vec<double> f = r.residual(w, mu);
+    if (calls == nan_call) f[3] = NAN;
+    return f;
+  }
+  jacobian_type jacobian(const vec<double>& w, double mu) const {
+    ++jacobian_calls;
+    jacobian_type a = r.jacobian(w, mu);
+    if (jacobian_calls == zero_jacobian_call) a *= 0.0;
+    return a;
+  }
+};
+
+bool contains(const std::string& s, const std::string& part) { return s.find(part) != std::string::npos; }
+
+newton_options reactor_options() {
+  newton_options o;
+  o.abs_tolerance = 1e-11;
+  o.max_iterations = 50;
+  return o;
+}
+}  // namespace
+
+// A singular Jacobian inside a step (here at the step from iterate 1) honours
+// throw_on_failure = false: a result, converged = false, naming the algorithm, the iterate,
+// ||F|| there, mu and the LU's own message; x is iterate 1, from which the run continues to the
+// uninjected answer. With throw_on_failure = true the same context is thrown as
+// singular_matrix_error.
+TEST(newton, SingularJacobianInAStepIsAFailedResultNamingTheIterate) {
+  const tubular_reactor base(16);
+  const double mu = 0.1;
+  const newton_options o = reactor_options();
+  const auto clean = newton(base, base.rest_state(), mu, o);
+  ASSERT_TRUE(clean.report.converged);
+  newton_options one = o;
+  one.max_iterations = 1;
+  one.throw_on_failure = false;
+  const auto first = newton(base, base.rest_state(), mu, one);  // iterate 1 of the same run
+  ASSERT_EQ(first.report.iterations, 1);
+
+  faulty_reactor f{base};
+  f.zero_jacobian_call = 2;
+  newton_options soft = o;
+  soft.throw_on_failure = false;
+  const vec<double> w0 = base.rest_state(), w0_copy = w0;
+  const auto r = newton(f, w0, mu, soft);
+  EXPECT_FALSE(r.report.converged);
+  EXPECT_EQ(r.report.failed_iteration, 2);
+  const std::string& why = r.report.reason;
+  EXPECT_TRUE(contains(why, "newton (equilibrium, mu = 0.1)")) << why;
+  EXPECT_TRUE(contains(why, "step 2 from iterate 1")) << why;
+  EXPECT_TRUE(contains(why, internal::concat("||F|| = ", first.report.final_residual()))) << why;
+  EXPECT_TRUE(contains(why, "newton: Jacobian: sparse LU failed")) << why;
+  EXPECT_EQ(w0, w0_copy);
+  EXPECT_EQ(r.x, first.x);
+  ASSERT_EQ(r.report.residual_history.size(), 2u);
+  const auto resumed = newton(base, r.x, mu, o);
+  ASSERT_TRUE(resumed.report.converged);
+  EXPECT_LT((resumed.x - clean.x).norm(), 1e-12);
+
+  faulty_reactor g{base};
+  g.zero_jacobian_call = 2;
+  try {
+    newton(g, w0, mu, o);
+    FAIL() << "expected singular_matrix_error";
+  } catch (const singular_matrix_error& e) {
+    EXPECT_TRUE(contains(e.what(), "step 2 from iterate 1")) << e.what();
+    EXPECT_TRUE(contains(e.what(), "mu = 0.1")) << e.what();
+    EXPECT_TRUE(contains(e.what(), "newton: Jacobian")) << e.what();
+  }
+  // the chord and Broyden factor their first matrix inside step 1: reported the same way
+  faulty_reactor h{base};
+  h.zero_jacobian_call = 1;
+  const auto c = newton_chord(h, w0, mu, soft);
+  EXPECT_FALSE(c.report.converged);
+  EXPECT_TRUE(contains(c.report.reason, "step 1 from iterate 0")) << c.report.reason;
+  EXPECT_EQ(c.x, w0);
+}
+
+// Any exception raised inside a step (a model refusing a state) is reported the same way and
+// keeps its type when thrown.
+TEST(newton, ExceptionFromTheResidualInsideAStepKeepsItsTypeAndGetsContext) {
+  const tubular_reactor base(16);
+  faulty_reactor f{base};
+  f.throw_call = 3;  // the trial point of step 2
+  newton_options soft = reactor_options();
+  soft.throw_on_failure = false;
+  const auto r = newton(f, base.rest_state(), 0.1, soft);
+  EXPECT_FALSE(r.report.converged);
+  EXPECT_TRUE(contains(r.report.reason, "step 2 from iterate 1")) << r.report.reason;
+  EXPECT_TRUE(contains(r.report.reason, "faulty_reactor: refused state")) << r.report.reason;
+  EXPECT_TRUE(r.x.allFinite());
+  faulty_reactor g{base};
+  g.throw_call = 3;
+  try {
+    newton(g, base.rest_state(), 0.1, reactor_options());
+    FAIL() << "expected an error";
+  } catch (const convergence_error&) {
+    FAIL() << "the type of the original error must be kept";
+  } catch (const error& e) {
+    EXPECT_TRUE(contains(e.what(), "step 2 from iterate 1")) << e.what();
+    EXPECT_TRUE(contains(e.what(), "refused state")) << e.what();
+  }
+}
+
+// Fault injection: the residual is NaN at the trial point of step k. The report names the
+// algorithm, the iterate, ||F|| and mu; the caller's start is untouched; x is the last good
+// iterate, from which the run continues (fault removed) to the uninjected answer.
+TEST(newton, NanResidualAtIterateKLeavesTheLastGoodIterate) {
+  const tubular_reactor base(16);
+  const double mu = 0.12;
+  const newton_options o = reactor_options();
+  const auto clean = newton(base, base.rest_state(), mu, o);
+  ASSERT_TRUE(clean.report.converged);
+  ASSERT_GE(clean.report.iterations, 3);
+  for (int k : {1, 2, 3}) {
+    faulty_reactor f{base};
+    f.nan_call = k + 1;  // call 1 is the initial residual, call k + 1 the trial point of step k
+    newton_options soft = o;
+    soft.throw_on_failure = false;
+    const vec<double> w0 = base.rest_state(), w0_copy = w0;
+    const auto r = newton(f, w0, mu, soft);
+    EXPECT_EQ(w0, w0_copy);
+    EXPECT_FALSE(r.report.converged);
+    EXPECT_EQ(r.report.failed_iteration, k);
+    const std::string& why = r.report.reason;
+    EXPECT_TRUE(contains(why, "newton (equilibrium, mu = 0.12)")) << why;
+    EXPECT_TRUE(contains(why, internal::concat("residual not finite at iterate ", k))) << why;
+    EXPECT_TRUE(contains(why, internal::concat("iterate ", k - 1, " (||F|| = ", clean.report.residual_history[k - 1])))
+        << why;
+    ASSERT_TRUE(r.x.allFinite());
+    EXPECT_NEAR(r.report.final_residual(), clean.report.residual_history[k - 1], 0.0);
+    const auto resumed = newton(base, r.x, mu, o);
+    ASSERT_TRUE(resumed.report.converged);
+    EXPECT_LT((resumed.x - clean.x).norm(), 1e-12) << "k = " << k;
+    // thrown: the same context
+    faulty_reactor g{base};
+    g.nan_call = k + 1;
+    try {
+      newton(g, w0, mu, o);
+      FAIL() << "expected convergence_error";
+    } catch (const convergence_error& e) {
+      EXPECT_EQ(std::string(e.what()), why);
+    }
+  }
+}
+
+// Options are validated at the entry point: a clear input_error naming the option, instead of
+// an iteration that burns its budget (NaN tolerance, zero relaxation).
+TEST(newton, RejectsBadOptionsNamingThem) {
+  circle c;
+  const vec<double> w0 = vec<double>::Constant(2, 3.0);
+  auto expect_refused = [&](newton_options o, const char* name) {
+    try {
+      newton(c, w0, 2.0, o);
+      ADD_FAILURE() << "expected input_error for " << name;
+    } catch (const input_error& e) {
+      EXPECT_TRUE(contains(e.what(), name)) << e.what();
+    }
+    o.throw_on_failure = false;  // refused even when failures are to be returned
+    EXPECT_THROW(newton_chord(c, w0, 2.0, o), input_error) << name;
+  };
+  newton_options o;
+  o.relaxation = 0;
+  expect_refused(o, "relaxation");
+  o.relaxation = -0.5;
+  expect_refused(o, "relaxation");
+  o.relaxation = 1.5;
+  expect_refused(o, "relaxation");
+  o = {};
+  o.abs_tolerance = NAN;
+  expect_refused(o, "abs_tolerance");
+  o = {};
+  o.rel_tolerance = NAN;
+  expect_refused(o, "rel_tolerance");
+  o = {};
+  o.abs_tolerance = 0;
+  expect_refused(o, "abs_tolerance");
+  o = {};
+  o.step_tolerance = NAN;
+  expect_refused(o, "step_tolerance");
+  o = {};
+  o.max_iterations = -1;
+  expect_refused(o, "max_iterations");
+  o = {};
+  o.divergence_factor = NAN;
+  expect_refused(o, "divergence_factor");
+  o = {};
+  o.relax_until = NAN;
+  expect_refused(o, "relax_until");
+  o = {};
+  o.contraction_from = 0;
+  expect_refused(o, "contraction_from");
+  pseudo_transient_options p;
+  p.dt0 = 0;
+  EXPECT_THROW(pseudo_transient_newton(c, w0, 2.0, {}, p), input_error);
+  p = {};
+  p.ser_exponent = NAN;
+  EXPECT_THROW(pseudo_transient_newton(c, w0, 2.0, {}, p), input_error);
+  // the engine itself: NaN start named by entry, before the residual is evaluated
+  int calls = 0;
+  vec<double> bad = w0;
+  bad[1] = NAN;
+  try {
+    newton_iterate([&](const vec<double>& x) { ++calls; return x; },
+                   [](const vec<double>&, const vec<double>& f, int) { return vec<double>(-f); }, bad, {}, "engine");
+    FAIL() << "expected input_error";
+  } catch (const input_error& e) {
+    EXPECT_TRUE(contains(e.what(), "initial iterate entry 1")) << e.what();
+  }
+  EXPECT_EQ(calls, 0);
+}

@@ -222,3 +222,79 @@ TEST(Bdf2, AmplitudeEnvelopeOfALandauTransient) {
   EXPECT_TRUE(amplitude_envelope({0.0, 1.0}, {1.0, 2.0}, 0.0).empty());
   EXPECT_THROW(amplitude_envelope({0.0}, {1.0, 2.0}, 0.0), input_error);
 }
+
+// ---- fault injection (reliability) ----
+namespace {
+/// The normal form whose residual is NaN (entry 0) on call nan_call, and whose Jacobian on call
+/// shift_call is c I (so that the inner matrix c I - A is zero: singular).
+struct faulty_normal_form {
+  using jacobian_type = Eigen::MatrixXd;
+  hopf_normal_form m;
+  int nan_call = -1, shift_call = -1;
+  double shift = 0;
+  mutable int calls = 0, jacobian_calls = 0;
+  Eigen::Index size() const { return m.size(); }
+  vec<double> residual(const vec<double>& w, double mu) const {
+    vec<double> f = m.residual(w, mu);
+    if (++calls == nan_call) f[0] = NAN;
+    return f;
+  }
+  Eigen::MatrixXd jacobian(const vec<double>& w, double mu) const {
+    if (++jacobian_calls == shift_call) return shift * Eigen::MatrixXd::Identity(size(), size());
+    return m.jacobian(w, mu);
+  }
+};
+}  // namespace
+
+// NaN unsteady residual inside the inner Newton iteration of time step n: time_march_error
+// names integrate_bdf2, the step, t, mu and what was non-finite, and carries the last good
+// state and the level before it (the clean run's states); resume_bdf2 from them, fault removed,
+// ends on the clean run's answer. A singular inner matrix stays singular_matrix_error, with the
+// time step, t and mu in front.
+TEST(Bdf2, NanResidualStopsWithTheLastTwoLevelsAndTheRunResumes) {
+  const hopf_normal_form m(1.0, 2, 3);
+  const double mu = 0.04;
+  const bdf2_options o{.dt = 0.05};
+  const vec<double> w0 = 0.3 * m.basis().col(0), w0_copy = w0;
+  std::vector<vec<double>> states;
+  const vec<double> clean =
+      integrate_bdf2(m, mu, w0, 0.0, 10.0, o, [&](const bdf2_step_info&, const vec<double>& w) { states.push_back(w); });
+  faulty_normal_form f{m};
+  f.nan_call = 40;
+  try {
+    integrate_bdf2(f, mu, w0, 0.0, 10.0, o);
+    FAIL() << "expected time_march_error";
+  } catch (const time_march_error<vec<double>>& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("integrate_bdf2: inner Newton iteration failed at time step"), std::string::npos) << what;
+    EXPECT_NE(what.find("mu = 0.04"), std::string::npos) << what;
+    EXPECT_NE(what.find("unsteady residual entry 0 is not finite"), std::string::npos) << what;
+    ASSERT_GE(e.step, 2);
+    EXPECT_EQ(e.state, states[static_cast<std::size_t>(e.step)]);
+    EXPECT_EQ(e.previous, states[static_cast<std::size_t>(e.step - 1)]);
+    EXPECT_NEAR(e.t, 0.05 * double(e.step), 1e-12);
+    EXPECT_EQ(w0, w0_copy);
+    bdf2_options again = o;
+    again.dt = e.dt;
+    const vec<double> resumed = resume_bdf2(m, mu, e.previous, e.state, e.t, 10.0, again);
+    EXPECT_LT((resumed - clean).norm(), 1e-12);
+  }
+  faulty_normal_form g{m};
+  g.shift_call = 7;
+  g.shift = 1.5 / 0.05;  // c of a BDF2 step
+  try {
+    integrate_bdf2(g, mu, w0, 0.0, 10.0, o);
+    FAIL() << "expected singular_matrix_error";
+  } catch (const singular_matrix_error& e) {
+    EXPECT_NE(std::string(e.what()).find("integrate_bdf2: time step "), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("mu = 0.04"), std::string::npos) << e.what();
+  }
+  vec<double> bad = w0;
+  bad[3] = NAN;
+  try {
+    integrate_bdf2(m, mu, bad, 0.0, 1.0, o);
+    FAIL() << "expected input_error";
+  } catch (const input_error& e) {
+    EXPECT_NE(std::string(e.what()).find("state entry 3"), std::string::npos) << e.what();
+  }
+}

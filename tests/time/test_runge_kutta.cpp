@@ -91,3 +91,61 @@ TEST(RungeKutta, RejectsBadInputAndReportsBlowUp) {
     EXPECT_NE(std::string(e.what()).find("step"), std::string::npos);
   }
 }
+
+// ---- fault injection (reliability) ----
+// A right-hand side that is NaN (entry 1) on call k: time_march_error names integrate_rk4, the
+// step, the stage and the entry, carries the last good state (the clean run's state at that
+// step); continuing from it without the fault ends on the clean run's answer. The caller's
+// initial state is untouched. An exception from the right-hand side keeps its type and gets the
+// step in front.
+TEST(RungeKutta, NanRightHandSideStopsWithTheLastGoodState) {
+  const hopf_normal_form m(1.0, 2, 3);
+  const double mu = 0.04;
+  const auto f = system_rhs(m, mu);
+  const vec<double> y0 = 0.3 * m.basis().col(0), y0_copy = y0;
+  std::vector<vec<double>> clean_states;
+  const vec<double> clean = integrate_rk4(f, y0, 0.0, 20.0, 0.05, [&](long, double, const vec<double>& y) {
+    clean_states.push_back(y);
+  });
+  int calls = 0;
+  auto faulty = [&](double t, const vec<double>& y) {
+    vec<double> d = f(t, y);
+    if (++calls == 4 * 37 + 2) d[1] = NAN;  // stage k2 of step 38
+    return d;
+  };
+  try {
+    integrate_rk4(faulty, y0, 0.0, 20.0, 0.05);
+    FAIL() << "expected time_march_error";
+  } catch (const time_march_error<vec<double>>& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("integrate_rk4: solution not finite at step 38"), std::string::npos) << what;
+    EXPECT_NE(what.find("stage k2 has a non-finite entry 1"), std::string::npos) << what;
+    EXPECT_EQ(e.step, 37);
+    EXPECT_NEAR(e.t, 37 * 0.05, 1e-12);
+    EXPECT_EQ(e.state, clean_states[37]);
+    EXPECT_EQ(y0, y0_copy);
+    const vec<double> resumed = integrate_rk4(f, e.state, e.t, 20.0, e.dt);
+    EXPECT_LT((resumed - clean).norm(), 1e-12);
+  }
+  auto throwing = [&](double t, const vec<double>& y) {
+    if (t > 1.0) throw error("rhs: refused");
+    return f(t, y);
+  };
+  try {
+    integrate_rk4(throwing, y0, 0.0, 20.0, 0.05);
+    FAIL() << "expected error";
+  } catch (const convergence_error&) {
+    FAIL() << "the type of the original error must be kept";
+  } catch (const error& e) {
+    EXPECT_NE(std::string(e.what()).find("integrate_rk4: step 21"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("rhs: refused"), std::string::npos) << e.what();
+  }
+  vec<double> bad = y0;
+  bad[2] = NAN;
+  try {
+    integrate_rk4(f, bad, 0.0, 1.0, 0.1);
+    FAIL() << "expected input_error";
+  } catch (const input_error& e) {
+    EXPECT_NE(std::string(e.what()).find("initial state entry 2"), std::string::npos) << e.what();
+  }
+}

@@ -16,6 +16,19 @@
 // right for small systems; large systems pass cayley_rightmost from cayley.hpp). Located
 // points: a fold by secant iteration on t_mu over the arclength step; a Hopf point by Newton on
 // the augmented system (hopf.hpp) started by inverse power at the interpolated crossing.
+//
+// Failures. A corrector that does not converge (no convergence in corrector_iterations, a
+// non-finite residual, a singular bordered Jacobian) is not a failure of the run: the step is
+// halved, and the run stops normally ("step size below ds_min") once ds < ds_min; the result
+// counts the failed correctors and keeps the last one's reason (step, ds, iteration, mu, ||f||,
+// what failed). A failure that ends the run (natural continuation: the Newton solve of a step;
+// both: the start equilibrium, a tangent, a spectrum, any exception from the system) is thrown
+// with throw_on_failure (its own type kept: singular_matrix_error stays one) or else returned
+// with failed = true; either way the message names the algorithm, the step and mu and carries
+// the original error text, and the points computed so far are kept (points.back() is the last
+// good one: continue from it). A Hopf point that cannot be located is dropped as spurious.
+// Input checks (input_error, before anything is evaluated): the options (finite, in range) and
+// a start of the system's size with finite entries.
 #include <Eigen/Core>
 #include <Eigen/Eigenvalues>
 
@@ -83,13 +96,43 @@ struct continuation_options {
   hopf_options hopf;                       ///< for locating Hopf points
   bool verbose = false;
   std::ostream* log = &std::cout;
+  bool throw_on_failure = true;  ///< false: a failure ending the run is returned (failed, stop_reason)
 };
 
 struct continuation_result {
   std::vector<branch_point> points;
   std::vector<detected_bifurcation> bifurcations;
   std::string stop_reason;
+  bool failed = false;                  ///< the run ended by a failure (stop_reason says which)
+  int corrector_failures = 0;           ///< pseudo-arclength correctors that failed (step halved)
+  std::string last_corrector_failure;   ///< the reason of the last one
 };
+
+/// Throws input_error naming the option and its value unless o is finite and in range
+/// (natural continuation: ds is the signed mu step, nonzero).
+inline void check_continuation_options(const continuation_options& o, const char* who, bool natural) {
+  if (natural) {
+    require(std::isfinite(o.ds) && o.ds != 0, who, ": continuation_options::ds must be finite and nonzero (got ", o.ds,
+            ")");
+  } else {
+    require(std::isfinite(o.ds) && o.ds > 0, who, ": continuation_options::ds must be finite and > 0 (got ", o.ds, ")");
+    require(std::isfinite(o.ds_min) && o.ds_min > 0, who, ": continuation_options::ds_min must be finite and > 0 (got ",
+            o.ds_min, ")");
+    require(std::isfinite(o.ds_max) && o.ds_max >= o.ds_min, who,
+            ": continuation_options::ds_max must be finite and >= ds_min (got ", o.ds_max, ")");
+    require(std::isfinite(o.w_scale) && o.w_scale > 0, who, ": continuation_options::w_scale must be finite and > 0 (got ",
+            o.w_scale, ")");
+  }
+  require(o.max_steps >= 0, who, ": continuation_options::max_steps must be >= 0 (got ", o.max_steps, ")");
+  require(!std::isnan(o.mu_min) && !std::isnan(o.mu_max) && o.mu_min <= o.mu_max, who,
+          ": continuation_options::mu_min <= mu_max required (got ", o.mu_min, ", ", o.mu_max, ")");
+  require(o.corrector_iterations >= 1, who, ": continuation_options::corrector_iterations must be >= 1 (got ",
+          o.corrector_iterations, ")");
+  require(std::isfinite(o.corrector_tolerance) && o.corrector_tolerance > 0, who,
+          ": continuation_options::corrector_tolerance must be finite and > 0 (got ", o.corrector_tolerance, ")");
+  require(std::isfinite(o.imag_tolerance) && o.imag_tolerance >= 0, who,
+          ": continuation_options::imag_tolerance must be finite and >= 0 (got ", o.imag_tolerance, ")");
+}
 
 namespace internal {
 template <dynamical_system S>
@@ -118,7 +161,9 @@ void evaluate_spectrum(const S& sys, branch_point& bp, const continuation_option
 template <dynamical_system S>
 continuation_result natural_continuation(const S& sys, const vec<double>& w0, double mu0,
                                          const continuation_options& opt = {}) {
-  check_state(sys, w0, mu0, "natural_continuation");
+  const char* who = "natural_continuation";
+  check_continuation_options(opt, who, true);
+  check_state(sys, w0, mu0, who);
   continuation_result res;
   newton_options no;
   no.abs_tolerance = opt.corrector_tolerance;
@@ -130,19 +175,25 @@ continuation_result natural_continuation(const S& sys, const vec<double>& w0, do
       res.stop_reason = "left the mu interval";
       break;
     }
-    newton_result nr;
-    try {
-      nr = newton(sys, w, mu, no);
-    } catch (const convergence_error& e) {
-      throw convergence_error(internal::concat("natural continuation: step ", k, " at mu = ", mu,
-                                               " failed (a fold? use pseudo-arclength): ", e.what()));
-    }
+    const std::string ctx = internal::concat(who, ": step ", k, " at mu = ", mu,
+                                             res.points.empty() ? std::string()
+                                                                : internal::concat(" (from mu = ", res.points.back().mu, ")"),
+                                             " failed (a fold? use pseudo-arclength): ");
     branch_point bp;
-    bp.mu = mu;
-    bp.w = w = nr.x;
-    bp.tangent_mu = 1;
-    bp.newton_iterations = nr.report.iterations;
-    if (opt.detect_hopf) internal::evaluate_spectrum(sys, bp, opt);
+    try {
+      const newton_result nr = newton(sys, w, mu, no);
+      bp.mu = mu;
+      bp.w = nr.x;
+      bp.tangent_mu = 1;
+      bp.newton_iterations = nr.report.iterations;
+      if (opt.detect_hopf) internal::evaluate_spectrum(sys, bp, opt);
+    } catch (...) {
+      res.failed = true;
+      res.stop_reason = ctx + internal::current_exception_text();
+      if (opt.throw_on_failure) internal::rethrow_with_context(ctx);
+      return res;
+    }
+    w = bp.w;
     res.points.push_back(std::move(bp));
   }
   if (res.stop_reason.empty()) res.stop_reason = "step limit";
@@ -155,10 +206,27 @@ template <dynamical_system S>
 continuation_result pseudo_arclength_continuation(const S& sys, const vec<double>& w0, double mu0,
                                                   const continuation_options& opt = {}, int direction = +1) {
   using M = jacobian_t<S>;
+  const char* who = "pseudo_arclength_continuation";
   const Eigen::Index n = sys.size();
-  check_state(sys, w0, mu0, "pseudo_arclength_continuation");
-  require(opt.ds > 0 && opt.ds_min > 0 && opt.ds_max >= opt.ds_min, "pseudo_arclength_continuation: bad step sizes");
+  check_continuation_options(opt, who, false);
+  check_state(sys, w0, mu0, who);
   continuation_result res;
+  // Runs body; an exception from it ends the run (file comment): rethrown with ctx in front,
+  // or recorded in res (failed, stop_reason) and false returned.
+  auto guarded = [&](const std::string& ctx, auto&& body) -> bool {
+    try {
+      body();
+      return true;
+    } catch (...) {
+      res.failed = true;
+      res.stop_reason = internal::concat(who, ": ", ctx, ": ", internal::current_exception_text());
+      if (opt.verbose && opt.log) *opt.log << res.stop_reason << "\n";
+      if (opt.throw_on_failure) internal::rethrow_with_context(internal::concat(who, ": ", ctx, ": "));
+      return false;
+    }
+  };
+  int step = 0;
+  double ds = opt.ds;
   // Scaled variables: the w-part of the arclength is weighted by 1 / (sqrt(n) w_scale).
   const double ws = 1.0 / (std::sqrt(double(n)) * opt.w_scale);
   auto dot = [&](const vec<double>& a, const vec<double>& b) {
@@ -181,40 +249,42 @@ continuation_result pseudo_arclength_continuation(const S& sys, const vec<double
     vec<double> t = lu.solve(rhs);
     return vec<double>(t / std::sqrt(dot(t, t)));
   };
-  // Corrector from the predicted point xp on the hyperplane t.(x - xp) = 0.
+  // Corrector from the predicted point xp on the hyperplane t.(x - xp) = 0; nullopt on failure
+  // (counted, the reason kept in res.last_corrector_failure).
   auto correct = [&](const vec<double>& xp, const vec<double>& t, int& iterations) -> std::optional<vec<double>> {
     vec<double> x = xp;
+    double fn = NAN;
+    auto failed = [&](int it, const std::string& why) -> std::optional<vec<double>> {
+      ++res.corrector_failures;
+      res.last_corrector_failure = internal::concat(who, ": corrector of step ", step, " (ds = ", ds, ") at iteration ",
+                                                    it, ", mu = ", x[n], ", ||f|| = ", fn, ": ", why);
+      return std::nullopt;
+    };
     for (int it = 1; it <= opt.corrector_iterations; ++it) {
       vec<double> f(n + 1);
-      f.head(n) = sys.residual(vec<double>(x.head(n)), x[n]);
-      f[n] = dot(t, x - xp);
-      if (!f.allFinite()) return std::nullopt;
       try {
+        f.head(n) = sys.residual(vec<double>(x.head(n)), x[n]);
+        f[n] = dot(t, x - xp);
+        for (Eigen::Index i = 0; i < f.size(); ++i)
+          if (!std::isfinite(f[i])) return failed(it, internal::concat("residual entry ", i, " is not finite"));
+        fn = f.head(n).norm();
         lu.compute(bordered(x, t));
-      } catch (const singular_matrix_error&) {
-        return std::nullopt;
+        x -= lu.solve(f);
+        iterations = it;
+        fn = vec<double>(sys.residual(vec<double>(x.head(n)), x[n])).norm();
+      } catch (const error& e) {
+        return failed(it, e.what());
       }
-      x -= lu.solve(f);
-      iterations = it;
-      const double fn = vec<double>(sys.residual(vec<double>(x.head(n)), x[n])).norm();
-      if (!std::isfinite(fn)) return std::nullopt;
+      if (!std::isfinite(fn)) return failed(it, "residual after the update is not finite");
       if (fn <= opt.corrector_tolerance) return x;
     }
-    return std::nullopt;
+    return failed(opt.corrector_iterations, "no convergence");
   };
 
   vec<double> x(n + 1);
   x.head(n) = w0;
   x[n] = mu0;
-  {  // make sure the start is an equilibrium
-    newton_options no;
-    no.abs_tolerance = opt.corrector_tolerance;
-    no.max_iterations = 2 * opt.corrector_iterations;
-    x.head(n) = newton(sys, w0, mu0, no).x;
-  }
-  vec<double> t0 = vec<double>::Zero(n + 1);
-  t0[n] = direction >= 0 ? 1.0 : -1.0;
-  vec<double> t = tangent(x, t0);
+  vec<double> t;
   auto push = [&](const vec<double>& xx, const vec<double>& tt, int iters) {
     branch_point bp;
     bp.w = xx.head(n);
@@ -228,24 +298,39 @@ continuation_result pseudo_arclength_continuation(const S& sys, const vec<double
                << "  newton " << iters << std::setprecision(6) << "\n";
     res.points.push_back(std::move(bp));
   };
-  push(x, t, 0);
-  double ds = opt.ds;
-  for (int step = 1; step <= opt.max_steps; ++step) {
+  if (!guarded(internal::concat("start at mu = ", mu0), [&] {
+        newton_options no;  // make sure the start is an equilibrium
+        no.abs_tolerance = opt.corrector_tolerance;
+        no.max_iterations = 2 * opt.corrector_iterations;
+        x.head(n) = newton(sys, w0, mu0, no).x;
+        vec<double> t0 = vec<double>::Zero(n + 1);
+        t0[n] = direction >= 0 ? 1.0 : -1.0;
+        t = tangent(x, t0);
+        push(x, t, 0);
+      }))
+    return res;
+  for (step = 1; step <= opt.max_steps; ++step) {
     int iters = 0;
     std::optional<vec<double>> xn;
     while (!(xn = correct(x + ds * t, t, iters))) {
       ds *= 0.5;
       if (ds < opt.ds_min) {
-        res.stop_reason = internal::concat("step size below ds_min at mu = ", x[n]);
+        res.stop_reason = internal::concat("step size below ds_min at mu = ", x[n], " (step ", step,
+                                           "; last corrector failure: ", res.last_corrector_failure, ")");
         if (opt.verbose && opt.log) *opt.log << "continuation: " << res.stop_reason << "\n";
         return res;
       }
     }
-    const vec<double> tn = tangent(*xn, t);
     const vec<double> x_prev = x, t_prev = t;
-    x = *xn;
-    t = tn;
-    push(x, t, iters);
+    if (!guarded(internal::concat("step ", step, ": tangent or spectrum at mu = ", (*xn)[n], " (from mu = ", x_prev[n],
+                                  ")"),
+                 [&] {
+                   const vec<double> tn = tangent(*xn, t);
+                   push(*xn, tn, iters);
+                   x = *xn;
+                   t = tn;
+                 }))
+      return res;
     const int k = int(res.points.size()) - 2;  // index of the previous point
     const branch_point& a = res.points[k];
     const branch_point& b = res.points[k + 1];
@@ -260,7 +345,12 @@ continuation_result pseudo_arclength_continuation(const S& sys, const vec<double
           int ci = 0;
           auto xs = correct(x_prev + s2 * t_prev, t_prev, ci);
           if (!xs) break;
-          const vec<double> ts = tangent(*xs, t_prev);
+          vec<double> ts;
+          try {
+            ts = tangent(*xs, t_prev);
+          } catch (const error&) {  // a singular bordered matrix: keep the best point so far
+            break;
+          }
           s0 = s1, f0 = f1, s1 = s2, f1 = ts[n];
           best = *xs;
           fold.locate_iterations = it;
@@ -285,15 +375,16 @@ continuation_result pseudo_arclength_continuation(const S& sys, const vec<double
         auto xs = correct(x_prev + th * len * t_prev, t_prev, ci);
         const vec<double> wg = xs ? vec<double>(xs->head(n)) : hb.w;
         const double mug = xs ? (*xs)[n] : hb.mu;
-        hopf_point guess = hopf_start(sys, wg, mug, hb.omega);
         try {
+          hopf_point guess = hopf_start(sys, wg, mug, hb.omega);
           const hopf_result hr = solve_hopf(sys, guess, opt.hopf);
+          if (!hr.report.converged) throw convergence_error(hr.report.reason);  // hopf.throw_on_failure = false
           hb.mu = hr.point.mu;
           hb.w = hr.point.w;
           hb.omega = hr.point.omega;
           hb.p = hr.point.p;
           hb.locate_iterations = hr.report.iterations;
-        } catch (const convergence_error& e) {
+        } catch (const error& e) {  // no convergence, a singular pivot: not located
           hb.mu = 1e300;  // not located: treated as spurious below
           if (opt.verbose && opt.log) *opt.log << "continuation: Hopf location failed: " << e.what() << "\n";
         }

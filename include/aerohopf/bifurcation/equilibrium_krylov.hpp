@@ -20,9 +20,14 @@
 //     non-physical or rising iterates.
 // Convergence: ||f(w, mu)||_2 <= newton.abs_tolerance (+ rel_tolerance ||f_0||), or a full step
 // at the rounding floor (newton_options::step_tolerance). Failure (no convergence in
-// max_iterations, a residual that is not finite, a GMRES failure, a non-physical state thrown by the
-// model) is a convergence_error naming `label` and the iterate; the caller's start is never
-// modified (it is taken by value).
+// max_iterations, a residual that is not finite, a GMRES failure, a BILU breakdown, a
+// non-physical state refused by the model) follows newton_iterate: with
+// newton.throw_on_failure (the default) it is thrown, an exception from inside a step with its
+// own type (a GMRES failure is a convergence_error, a BILU breakdown a singular_matrix_error),
+// else returned with report.converged = false and w the last good iterate; the message names
+// `label`, the iterate, ||f|| and mu. The caller's start is never modified (it is taken by
+// value). Input checks (input_error): the options, a finite mu, a finite start of the system's
+// size (the first bad entry named).
 //
 // B: block size of the unknowns for BILU (4 for 2D Euler + pitch-plunge), S any
 // dynamical_system with sparse Jacobians (with block_jacobians the assembly is shared).
@@ -79,17 +84,24 @@ inline double inexact_forcing(double fn, double abs_tol, double eta_max) {
 /// The Newton-Krylov equilibrium solve of solve_equilibrium_krylov with the caller's BILU object
 /// (after the call it holds the factorisation of lhs_jacobian at the start, which the symmetric
 /// Hopf-curve tracer reuses for dw0/dnu). linear_iterations is incremented, not reset.
+/// Failures are thrown unless throw_on_failure is false (then returned, newton_iterate's
+/// contract); the default true is the contract of the nested solves of the Hopf-curve tracer.
 template <int B, dynamical_system S>
 newton_result equilibrium_newton_krylov(const S& sys, double mu, vec<double> w, const equilibrium_krylov_options& o,
-                                        block_ilu<double, B>& ilu, long& linear_iterations, const std::string& label) {
+                                        block_ilu<double, B>& ilu, long& linear_iterations, const std::string& label,
+                                        bool throw_on_failure = true) {
   const Eigen::Index n = sys.size();
-  require(w.size() == n, label, ": start has ", w.size(), " entries, system ", n);
+  require_size(w.size(), n, label, "start");
+  require(std::isfinite(mu), label, ": mu is not finite (", mu, ")");
+  require_finite(w, label, "start");
   require(o.newton.abs_tolerance > 0 || o.newton.rel_tolerance > 0, label,
           ": Newton needs abs_tolerance > 0 or rel_tolerance > 0");
   require(o.eta_max > 0 && o.eta_max < 1, label, ": eta_max must lie in (0, 1) (got ", o.eta_max, ")");
+  check_newton_options(o.newton, label);
   const Eigen::Index padded = padded_block_count(n, B) * B;
   newton_options no = o.newton;
-  no.throw_on_failure = true;
+  no.throw_on_failure = throw_on_failure;
+  if (!no.describe) no.describe = [mu](const vec<double>&) { return internal::concat("mu = ", mu); };
   block_sparse_matrix<double, B> a;
   return newton_iterate(
       [&](const vec<double>& v) { return vec<double>(sys.residual(v, mu)); },
@@ -114,9 +126,8 @@ newton_result equilibrium_newton_krylov(const S& sys, double mu, vec<double> w, 
 }
 }  // namespace internal
 
-/// Newton-Krylov solve of f(w, mu) = 0 from the nearby state w0 (file comment). Throws
-/// convergence_error (what failed, at which iterate) and input_error for a start of the wrong
-/// size or with non-finite entries.
+/// Newton-Krylov solve of f(w, mu) = 0 from the nearby state w0 (file comment; failures and
+/// input checks there).
 template <int B, dynamical_system S>
   requires is_sparse_matrix_v<jacobian_t<S>>
 equilibrium_krylov_result solve_equilibrium_krylov(const S& sys, double mu, vec<double> w0,
@@ -130,17 +141,10 @@ equilibrium_krylov_result solve_equilibrium_krylov(const S& sys, double mu, vec<
   io.context = label + ": real BILU(" + std::to_string(o.fill_level) + ") of lhs_jacobian";
   block_ilu<double, B> ilu(io);
   equilibrium_krylov_result r;
-  try {
-    newton_result nr = internal::equilibrium_newton_krylov<B>(sys, mu, std::move(w0), o, ilu, r.linear_iterations, label);
-    r.w = std::move(nr.x);
-    r.report = std::move(nr.report);
-  } catch (const convergence_error&) {
-    throw;
-  } catch (const input_error&) {
-    throw;
-  } catch (const error& e) {  // a non-physical iterate thrown by the model, a singular pivot
-    throw convergence_error(label + ": " + e.what());
-  }
+  newton_result nr = internal::equilibrium_newton_krylov<B>(sys, mu, std::move(w0), o, ilu, r.linear_iterations, label,
+                                                            o.newton.throw_on_failure);
+  r.w = std::move(nr.x);
+  r.report = std::move(nr.report);
   r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return r;
 }

@@ -28,6 +28,9 @@
 
 #include <cmath>
 #include <concepts>
+#include <exception>
+#include <new>
+#include <string>
 #include <type_traits>
 
 #include "../error.hpp"
@@ -76,13 +79,47 @@ concept has_jacobian_directional =
 template <system S>
 using jacobian_t = typename S::jacobian_type;
 
-/// Throws input_error if w has the wrong size or a non-finite entry (names the entry).
+namespace internal {
+/// Inside a catch block: rethrows the exception being handled with `context` in front of its
+/// message, keeping its aerohopf type (a foreign std::exception becomes convergence_error;
+/// std::bad_alloc and non-std exceptions pass unchanged).
+[[noreturn]] inline void rethrow_with_context(const std::string& context) {
+  try {
+    throw;
+  } catch (const singular_matrix_error& e) {
+    throw singular_matrix_error(context + e.what());
+  } catch (const input_error& e) {
+    throw input_error(context + e.what());
+  } catch (const convergence_error& e) {
+    throw convergence_error(context + e.what());
+  } catch (const error& e) {
+    throw error(context + e.what());
+  } catch (const std::bad_alloc&) {
+    throw;
+  } catch (const std::exception& e) {
+    throw convergence_error(context + e.what());
+  }
+}
+
+/// The message of the exception being handled (inside a catch block).
+inline std::string current_exception_text() {
+  try {
+    throw;
+  } catch (const std::exception& e) {
+    return e.what();
+  } catch (...) {
+    return "unknown exception";
+  }
+}
+}  // namespace internal
+
+/// Throws input_error if w has the wrong size or a non-finite entry (names the first one), or
+/// if mu is not finite.
 template <system S>
 void check_state(const S& s, const vec<double>& w, double mu, const char* who) {
-  require(w.size() == s.size(), who, ": state has ", w.size(), " entries, system has ", s.size());
-  require(std::isfinite(mu), who, ": parameter mu is not finite");
-  for (Eigen::Index i = 0; i < w.size(); ++i)
-    require(std::isfinite(w[i]), who, ": state entry ", i, " is not finite (", w[i], ")");
+  require_size(w.size(), s.size(), who, "state");
+  require(std::isfinite(mu), who, ": parameter mu is not finite (", mu, ")");
+  require_finite(w, who, "state");
 }
 
 /// The approximate (left-hand-side) Jacobian if the system has one, else the exact one.

@@ -18,8 +18,17 @@
 // Inner convergence: ||dw||_inf <= inner_tolerance * (1 + ||w||_inf) (in dual time also
 // ||R||_inf / c below the same bound), or, with inner_residual_drop > 0, ||R||_inf dropped by
 // that factor from its value at the first inner iterate of the step (the CFD practice: "three
-// orders per real step"). If neither is reached in max_inner_iterations, convergence_error
-// names the time step, time, iterations and residual.
+// orders per real step").
+//
+// Failures: if neither is reached in max_inner_iterations, or the unsteady residual or the
+// iterate becomes non-finite, time_march_error<vec<double>> (a convergence_error) names
+// integrate_bdf2, the time step, its time, mu, the inner iteration, ||R||_inf, the last
+// ||dw||_inf and what was non-finite, and carries the last good state and the level before it:
+// resume_bdf2 continues from them with BDF2 steps exactly as the uninterrupted run. An
+// exception inside an inner iteration (a singular inner matrix, a model error) is rethrown with
+// its own type and the same context in front of its message (the observer has seen the last
+// good state). Input checks (input_error): the options, times, a finite state of the system's
+// size (the first bad entry named), finite mu.
 //
 // CFD-sized systems: the inner matrix may be the system's approximate (modified-order)
 // Jacobian (approximate_jacobian) and may be formed and factored once per physical step
@@ -56,14 +65,17 @@ struct bdf2_step_info {
   double inner_residual = 0;    ///< ||R(w)||_inf at the accepted iterate (before the last update)
 };
 
-/// Integrates from w0 at t0 to t_end; calls observer(const bdf2_step_info&, const vec<double>& w)
-/// at the start and after every step; returns w(t_end). solver: compute(matrix)/solve(vector)
-/// for the inner matrix (c + 1/pseudo_dt) I - A.
+namespace internal {
+/// The BDF2 march of integrate_bdf2 and resume_bdf2: from w at t0, with w_prev the level at
+/// t0 - h when `resume` (first step BDF2), else w_prev unused (first step BDF1).
 template <dynamical_system S, class Observer, class Solver>
-vec<double> integrate_bdf2(const S& s, double mu, vec<double> w0, double t0, double t_end, const bdf2_options& opt,
-                           Observer&& observer, Solver& solver) {
-  const char* who = "integrate_bdf2";
-  check_state(s, w0, mu, who);
+vec<double> bdf2_march(const S& s, double mu, vec<double> w_prev, vec<double> w, bool resume, double t0, double t_end,
+                       const bdf2_options& opt, Observer&& observer, Solver& solver, const char* who) {
+  check_state(s, w, mu, who);
+  if (resume) {
+    require_size(w_prev.size(), s.size(), who, "previous state");
+    require_finite(w_prev, who, "previous state");
+  }
   const long steps = internal::step_count(t0, t_end, opt.dt, who);
   require(std::isfinite(opt.inner_tolerance) && opt.inner_tolerance > 0, who,
           ": inner_tolerance must be positive (got ", opt.inner_tolerance, ")");
@@ -74,61 +86,114 @@ vec<double> integrate_bdf2(const S& s, double mu, vec<double> w0, double t0, dou
   const double h = steps > 0 ? (t_end - t0) / double(steps) : 0.0;
 
   using matrix = jacobian_t<S>;
-  vec<double> w_prev = w0, w = std::move(w0);
+  if (!resume) w_prev = vec<double>();
   bdf2_step_info info;
   info.t = t0;
   observer(static_cast<const bdf2_step_info&>(info), static_cast<const vec<double>&>(w));
 
   for (long n = 1; n <= steps; ++n) {
-    const bool first = n == 1;
+    const bool first = n == 1 && !resume;
     const double c = first ? 1.0 / h : 1.5 / h;
     const double shift = c + (opt.pseudo_dt > 0 ? 1.0 / opt.pseudo_dt : 0.0);
+    const double tn = t0 + double(n) * h;
     // History part of the unsteady residual: R(x) = c x - hist - f(x).
     const vec<double> hist = first ? vec<double>(w / h) : vec<double>((4.0 * w - w_prev) / (2.0 * h));
     vec<double> x = first ? w : vec<double>(2.0 * w - w_prev);  // linear extrapolation as guess
     bool converged = false;
-    double rnorm = 0, dnorm = 0, r0 = 0;
+    double rnorm = NAN, dnorm = NAN, r0 = 0;
     int it = 0;
-    while (it < opt.max_inner_iterations) {
-      const vec<double> r = c * x - hist - s.residual(x, mu);
-      rnorm = r.template lpNorm<Eigen::Infinity>();
-      if (!std::isfinite(rnorm)) break;
-      if (it == 0) r0 = rnorm;
-      if (it > 0 && opt.inner_residual_drop > 0 && rnorm <= opt.inner_residual_drop * r0) {
-        converged = true;
-        break;
+    std::string bad;  // what became non-finite
+    try {
+      while (it < opt.max_inner_iterations) {
+        const vec<double> r = c * x - hist - s.residual(x, mu);
+        for (Eigen::Index i = 0; i < r.size() && bad.empty(); ++i)
+          if (!std::isfinite(r[i])) bad = internal::concat("unsteady residual entry ", i, " is not finite");
+        if (!bad.empty()) break;
+        rnorm = r.template lpNorm<Eigen::Infinity>();
+        if (it == 0) r0 = rnorm;
+        if (it > 0 && opt.inner_residual_drop > 0 && rnorm <= opt.inner_residual_drop * r0) {
+          converged = true;
+          break;
+        }
+        ++it;
+        if (it == 1 || !opt.freeze_matrix) {
+          const matrix a = opt.approximate_jacobian ? lhs_jacobian(s, x, mu) : matrix(s.jacobian(x, mu));
+          const matrix lhs = matrix(identity_like<double>(a) * shift) - a;
+          solver.compute(lhs);
+        }
+        const vec<double> dx = solver.solve(vec<double>(-r));
+        x += dx;
+        dnorm = dx.template lpNorm<Eigen::Infinity>();
+        if (!std::isfinite(dnorm)) {
+          bad = "inner correction dw is not finite";
+          break;
+        }
+        const double scale = opt.inner_tolerance * (1.0 + x.template lpNorm<Eigen::Infinity>());
+        // In dual time a small pseudo step makes dw small long before R is: also require the
+        // plain implicit correction R / c to be small.
+        if (dnorm <= scale && (opt.pseudo_dt == 0 || rnorm / c <= scale)) {
+          converged = true;
+          break;
+        }
       }
-      ++it;
-      if (it == 1 || !opt.freeze_matrix) {
-        const matrix a = opt.approximate_jacobian ? lhs_jacobian(s, x, mu) : matrix(s.jacobian(x, mu));
-        const matrix lhs = matrix(identity_like<double>(a) * shift) - a;
-        solver.compute(lhs);
-      }
-      const vec<double> dx = solver.solve(vec<double>(-r));
-      x += dx;
-      dnorm = dx.template lpNorm<Eigen::Infinity>();
-      const double scale = opt.inner_tolerance * (1.0 + x.template lpNorm<Eigen::Infinity>());
-      // In dual time a small pseudo step makes dw small long before R is: also require the
-      // plain implicit correction R / c to be small.
-      if (dnorm <= scale && (opt.pseudo_dt == 0 || rnorm / c <= scale)) {
-        converged = true;
-        break;
-      }
+    } catch (...) {
+      internal::rethrow_with_context(internal::concat(who, ": time step ", n, " (t = ", tn, ", mu = ", mu, "), inner ",
+                                                      opt.pseudo_dt > 0 ? "dual-time" : "Newton", " iteration ",
+                                                      it, " (||R||_inf = ", rnorm, ") failed: "));
     }
     if (!converged || !x.allFinite())
-      throw convergence_error(internal::concat(who, ": inner ", opt.pseudo_dt > 0 ? "dual-time" : "Newton",
-                                               " iteration failed at time step ", n, " (t = ", t0 + double(n) * h,
-                                               ") after ", it, " iterations: ||R||_inf = ", rnorm,
-                                               ", last ||dw||_inf = ", dnorm));
+      throw time_march_error<vec<double>>(
+          internal::concat(who, ": inner ", opt.pseudo_dt > 0 ? "dual-time" : "Newton", " iteration failed at time step ",
+                           n, " (t = ", tn, ", mu = ", mu, ") after ", it, " iterations: ",
+                           bad.empty() ? std::string("no convergence") : bad, "; ||R||_inf = ", rnorm,
+                           ", last ||dw||_inf = ", dnorm, "; the last good state is that of step ", n - 1, " at t = ",
+                           tn - h),
+          n - 1, tn - h, h, w, w_prev);
     w_prev = std::move(w);
     w = std::move(x);
     info.step = n;
-    info.t = t0 + double(n) * h;
+    info.t = tn;
     info.inner_iterations = it;
     info.inner_residual = rnorm;
     observer(static_cast<const bdf2_step_info&>(info), static_cast<const vec<double>&>(w));
   }
   return w;
+}
+}  // namespace internal
+
+/// Integrates from w0 at t0 to t_end; calls observer(const bdf2_step_info&, const vec<double>& w)
+/// at the start and after every step; returns w(t_end). solver: compute(matrix)/solve(vector)
+/// for the inner matrix (c + 1/pseudo_dt) I - A. Failures: file comment.
+template <dynamical_system S, class Observer, class Solver>
+vec<double> integrate_bdf2(const S& s, double mu, vec<double> w0, double t0, double t_end, const bdf2_options& opt,
+                           Observer&& observer, Solver& solver) {
+  return internal::bdf2_march(s, mu, vec<double>(), std::move(w0), false, t0, t_end, opt,
+                              std::forward<Observer>(observer), solver, "integrate_bdf2");
+}
+
+/// Continues a BDF2 run from two consecutive levels, w at t0 and w_prev at t0 - h (e.g. state
+/// and previous of a time_march_error), with BDF2 from the first step. h is the step this call
+/// takes, (t_end - t0) / steps with steps from opt.dt as in integrate_bdf2: pass the interrupted
+/// run's step (time_march_error::dt) as opt.dt to go on exactly as it would have.
+template <dynamical_system S, class Observer, class Solver>
+vec<double> resume_bdf2(const S& s, double mu, vec<double> w_prev, vec<double> w, double t0, double t_end,
+                        const bdf2_options& opt, Observer&& observer, Solver& solver) {
+  return internal::bdf2_march(s, mu, std::move(w_prev), std::move(w), true, t0, t_end, opt,
+                              std::forward<Observer>(observer), solver, "resume_bdf2");
+}
+
+template <dynamical_system S, class Observer>
+vec<double> resume_bdf2(const S& s, double mu, vec<double> w_prev, vec<double> w, double t0, double t_end,
+                        const bdf2_options& opt, Observer&& observer) {
+  direct_solver<jacobian_t<S>> solver("resume_bdf2: inner Newton matrix");
+  return resume_bdf2(s, mu, std::move(w_prev), std::move(w), t0, t_end, opt, std::forward<Observer>(observer), solver);
+}
+
+template <dynamical_system S>
+vec<double> resume_bdf2(const S& s, double mu, vec<double> w_prev, vec<double> w, double t0, double t_end,
+                        const bdf2_options& opt) {
+  return resume_bdf2(s, mu, std::move(w_prev), std::move(w), t0, t_end, opt,
+                     [](const bdf2_step_info&, const vec<double>&) {});
 }
 
 /// Same with the direct solver of the system's matrix type.

@@ -4,6 +4,8 @@
 // of equal steps ends exactly on t_end (histories of different runs then align in time).
 #include <algorithm>
 #include <cmath>
+#include <string>
+#include <utility>
 #include <vector>
 
 #include "../error.hpp"
@@ -14,6 +16,23 @@ template <class State>
 struct time_history {
   std::vector<double> t;
   std::vector<State> y;
+};
+
+/// A time march stopped because its solution (or an implicit step's inner iteration) became
+/// non-finite or did not converge at step `step + 1`. It carries the last good state, so the
+/// run can continue from it: `state` at time `t` after `step` steps of size `dt` (step 0: the
+/// initial state), and for BDF2 `previous`, the level at t - dt (empty for RK4 and at step 0),
+/// which resume_bdf2 takes to go on with BDF2 steps as an uninterrupted run would.
+template <class State>
+struct time_march_error : convergence_error {
+  time_march_error(const std::string& message, long step_, double t_, double dt_, State state_, State previous_ = {})
+      : convergence_error(message), step(step_), t(t_), dt(dt_), state(std::move(state_)),
+        previous(std::move(previous_)) {}
+  long step;
+  double t;
+  double dt;
+  State state;
+  State previous;
 };
 
 namespace internal {
