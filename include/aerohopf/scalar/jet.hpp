@@ -99,7 +99,7 @@ class jet {
     for (int k = 0; k < N; ++k) d_[k] -= b.d_[k];
     return *this;
   }
-  // Values are copied first: x *= x and x /= x alias b with *this.
+  // b may be *this (x *= x): the values are read before any member is written.
   jet& operator*=(const jet& b) {
     const T av = v_, bv = b.v_;
     for (int k = 0; k < N; ++k) d_[k] = av * b.d_[k] + bv * d_[k];
