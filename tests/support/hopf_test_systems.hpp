@@ -9,7 +9,8 @@
 //    w* = c). Quadratic terms make A depend on w. Jacobian dense or sparse.
 //  * faulty_system<S>: S whose residual (every scalar type, so the matrix-free products count
 //    too) returns NaN at the calls fault_at, fault_at + 1, ..., fault_at + fault_count - 1
-//    (counted from 1; a shared counter, so copies count together).
+//    (counted from 1; a shared counter, so copies count together, and the members of a
+//    family can share one).
 #include <aerohopf/error.hpp>
 #include <aerohopf/nonlinear/system.hpp>
 
@@ -77,6 +78,9 @@ class faulty_system {
 
   faulty_system(S s, long fault_at, long fault_count = 1)
       : s_(std::move(s)), calls_(std::make_shared<long>(0)), at_(fault_at), count_(fault_count) {}
+  /// With a counter shared by several systems (a family: family(nu) builds one per nu).
+  faulty_system(S s, std::shared_ptr<long> counter, long fault_at, long fault_count = 1)
+      : s_(std::move(s)), calls_(std::move(counter)), at_(fault_at), count_(fault_count) {}
   Eigen::Index size() const { return s_.size(); }
   long calls() const { return *calls_; }
 

@@ -137,28 +137,34 @@ namespace internal {
 /// Throws input_error naming the offending option unless the Newton and acceptance options of
 /// a Hopf solve are usable: tolerances finite and >= 0 (not both zero), max_iterations >= 1,
 /// relaxation in (0, 1], factors positive.
-inline void check_hopf_options(const hopf_options& o, const std::string& where) {
-  const newton_options& n = o.newton;
+/// The Newton part of those checks; `name` is how the caller's options call the struct
+/// ("newton", "start.newton", ...).
+inline void check_newton_options(const newton_options& n, const std::string& where, const std::string& name) {
   auto finite_nonneg = [&](double v, const char* what) {
-    require(std::isfinite(v) && v >= 0, where, ": ", what, " must be finite and >= 0 (got ", v, ")");
+    require(std::isfinite(v) && v >= 0, where, ": ", name, ".", what, " must be finite and >= 0 (got ", v, ")");
   };
-  finite_nonneg(n.abs_tolerance, "newton.abs_tolerance");
-  finite_nonneg(n.rel_tolerance, "newton.rel_tolerance");
-  finite_nonneg(n.step_tolerance, "newton.step_tolerance");
-  require(n.abs_tolerance > 0 || n.rel_tolerance > 0, where,
-          ": newton.abs_tolerance and newton.rel_tolerance are both 0 (no convergence target)");
-  require(n.max_iterations >= 1, where, ": newton.max_iterations must be >= 1 (got ", n.max_iterations, ")");
-  require(n.relaxation > 0 && n.relaxation <= 1, where, ": newton.relaxation must lie in (0, 1] (got ", n.relaxation,
-          ")");
-  require(n.relax_until >= 0 && !std::isnan(n.relax_until), where, ": newton.relax_until must be >= 0 (got ",
+  finite_nonneg(n.abs_tolerance, "abs_tolerance");
+  finite_nonneg(n.rel_tolerance, "rel_tolerance");
+  finite_nonneg(n.step_tolerance, "step_tolerance");
+  require(n.abs_tolerance > 0 || n.rel_tolerance > 0, where, ": ", name, ".abs_tolerance and ", name,
+          ".rel_tolerance are both 0 (no convergence target)");
+  require(n.max_iterations >= 1, where, ": ", name, ".max_iterations must be >= 1 (got ", n.max_iterations, ")");
+  require(n.relaxation > 0 && n.relaxation <= 1, where, ": ", name, ".relaxation must lie in (0, 1] (got ",
+          n.relaxation, ")");
+  require(n.relax_until >= 0 && !std::isnan(n.relax_until), where, ": ", name, ".relax_until must be >= 0 (got ",
           n.relax_until, ")");
-  require(n.divergence_factor > 0 && !std::isnan(n.divergence_factor), where,
-          ": newton.divergence_factor must be > 0 (got ", n.divergence_factor, ")");
-  require(n.max_contraction > 0 && !std::isnan(n.max_contraction), where, ": newton.max_contraction must be > 0 (got ",
-          n.max_contraction, ")");
+  require(n.divergence_factor > 0 && !std::isnan(n.divergence_factor), where, ": ", name,
+          ".divergence_factor must be > 0 (got ", n.divergence_factor, ")");
+  require(n.max_contraction > 0 && !std::isnan(n.max_contraction), where, ": ", name,
+          ".max_contraction must be > 0 (got ", n.max_contraction, ")");
+}
+
+inline void check_hopf_options(const hopf_options& o, const std::string& where) {
+  check_newton_options(o.newton, where, "newton");
   require(std::isfinite(o.equilibrium_factor) && o.equilibrium_factor >= 1, where,
           ": equilibrium_factor must be finite and >= 1 (got ", o.equilibrium_factor, ")");
-  finite_nonneg(o.equilibrium_tolerance, "equilibrium_tolerance");
+  require(std::isfinite(o.equilibrium_tolerance) && o.equilibrium_tolerance >= 0, where,
+          ": equilibrium_tolerance must be finite and >= 0 (got ", o.equilibrium_tolerance, ")");
 }
 
 /// ||v||_2, or NaN if an entry is not finite.
@@ -250,27 +256,29 @@ void hopf_accept(const S& sys, hopf_result& r, const hopf_options& opt, bool fix
 struct hopf_iterate_log {
   int iteration = 0;       ///< 0: the start
   double residual = NAN;   ///< ||F|| there (NaN: not evaluated yet)
-  double mu = NAN, omega = NAN;
+  double mu = NAN, omega = NAN, nu = NAN;
   vec<double> x;
   std::vector<double> history;
 
-  hopf_iterate_log(const vec<double>& x0, Eigen::Index imu, Eigen::Index iom)
-      : mu(x0[imu]), omega(x0[iom]), x(x0), imu_(imu), iom_(iom) {}
+  /// x0: the start; imu, iom (and inu >= 0 for a curve tracer): where mu, omega (nu) are in x.
+  hopf_iterate_log(const vec<double>& x0, Eigen::Index imu, Eigen::Index iom, Eigen::Index inu = -1)
+      : mu(x0[imu]), omega(x0[iom]), nu(inu >= 0 ? x0[inu] : NAN), x(x0), imu_(imu), iom_(iom), inu_(inu) {}
   void record(const vec<double>& y, const vec<double>& f, int k) {
     iteration = k - 1;  // the step of iteration k starts from iterate k - 1
     residual = hopf_norm(f);
     mu = y[imu_];
     omega = y[iom_];
+    if (inu_ >= 0) nu = y[inu_];
     x = y;
     if (history.size() < std::size_t(k)) history.push_back(residual);
   }
   std::string describe() const {
-    return concat(" [last accepted iterate ", iteration, ": ||F|| = ", residual, ", mu = ", mu, ", omega = ", omega,
-                  "]");
+    return concat(" [last accepted iterate ", iteration, ": ||F|| = ", residual, inu_ >= 0 ? concat(", nu = ", nu) : "",
+                  ", mu = ", mu, ", omega = ", omega, "]");
   }
 
  private:
-  Eigen::Index imu_, iom_;
+  Eigen::Index imu_, iom_, inu_;
 };
 
 /// Runs the Newton iteration run() of a Hopf solver and puts the last accepted iterate into any
@@ -282,7 +290,7 @@ template <class Run>
 newton_result run_hopf_newton(Run&& run, const hopf_iterate_log& last, const hopf_options& opt) {
   try {
     newton_result nr = run();
-    if (!nr.report.converged) nr.report.reason += last.describe();
+    if (!nr.report.converged) nr.report.reason = opt.label + ": " + nr.report.reason + last.describe();
     return nr;
   } catch (const input_error&) {
     rethrow_with_context(opt.label + ": ", last.describe());
@@ -291,7 +299,7 @@ newton_result run_hopf_newton(Run&& run, const hopf_iterate_log& last, const hop
     newton_result nr;
     nr.x = last.x;
     nr.report.converged = false;
-    nr.report.reason = e.what() + last.describe();
+    nr.report.reason = opt.label + ": " + e.what() + last.describe();
     nr.report.iterations = last.iteration;
     nr.report.residual_history = last.history;
     return nr;
