@@ -10,7 +10,8 @@
 //  * faulty_system<S>: S whose residual (every scalar type, so the matrix-free products count
 //    too) returns NaN at the calls fault_at, fault_at + 1, ..., fault_at + fault_count - 1
 //    (counted from 1; a shared counter, so copies count together, and the members of a
-//    family can share one).
+//    family can share one). Its Jacobians are S's (not counted).
+//  * mu_shifted_system<S>: S with its equilibrium moved along c with mu, w*(mu) = w*_S + c mu.
 #include <aerohopf/error.hpp>
 #include <aerohopf/nonlinear/system.hpp>
 
@@ -93,11 +94,40 @@ class faulty_system {
     return f;
   }
   jacobian_type jacobian(const vec<double>& w, double mu) const { return s_.jacobian(w, mu); }
+  jacobian_type approximate_jacobian(const vec<double>& w, double mu) const
+    requires has_approximate_jacobian<S>
+  {
+    return s_.approximate_jacobian(w, mu);
+  }
 
  private:
   S s_;
   std::shared_ptr<long> calls_;
   long at_, count_;
+};
+
+template <class S>
+class mu_shifted_system {
+ public:
+  using jacobian_type = typename S::jacobian_type;
+  mu_shifted_system(S s, vec<double> c) : s_(std::move(s)), c_(std::move(c)) {}
+  Eigen::Index size() const { return s_.size(); }
+  template <class T>
+  vec<T> residual(const vec<T>& w, const T& mu) const {
+    vec<T> ws(w.size());
+    for (Eigen::Index i = 0; i < w.size(); ++i) ws[i] = w[i] - T(c_[i]) * mu;
+    return s_.residual(ws, mu);
+  }
+  jacobian_type jacobian(const vec<double>& w, double mu) const { return s_.jacobian(vec<double>(w - c_ * mu), mu); }
+  jacobian_type approximate_jacobian(const vec<double>& w, double mu) const
+    requires has_approximate_jacobian<S>
+  {
+    return s_.approximate_jacobian(vec<double>(w - c_ * mu), mu);
+  }
+
+ private:
+  S s_;
+  vec<double> c_;
 };
 
 }  // namespace aerohopf::test_support
