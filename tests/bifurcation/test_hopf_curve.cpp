@@ -556,3 +556,29 @@ TEST(hopf_curve_hostile, a_persistent_nan_stops_the_trace_with_context_and_it_re
   EXPECT_NEAR(land->mu, ref_land->mu, 1e-9);
   EXPECT_NEAR(land->omega, ref_land->omega, 1e-9);
 }
+
+// A start at the real eigenvalue mu = 0 of a family (tests/support/hopf_test_systems.hpp) with
+// omega_min = 0 and tolerances 1e-8: solve_hopf converges to omega ~ 1e-11, which that
+// tolerance does not resolve. Refused, instead of tracing the fold line mu = 0 as "Hopf points".
+TEST(hopf_curve_hostile, a_start_at_a_real_eigenvalue_is_refused) {
+  using test_support::moving_equilibrium_system;
+  using cplx = std::complex<double>;
+  auto family = [](double nu) { return moving_equilibrium_system<>(Eigen::Vector4d(nu, 0.5 * nu, 0, 0)); };
+  const auto s0 = family(0.3);
+  hopf_point g = hopf_start(s0, s0.equilibrium(0.2), 0.2, 0.3);
+  vec<cplx> q(4);
+  q << cplx(0.1, 0.7), cplx(-0.4, 0.2), cplx(0.3, -0.5), cplx(0.6, 0.1);
+  g.p += 0.3 * q;
+  hopf_curve_options o;
+  o.omega_min = 0;
+  o.start.newton.abs_tolerance = 1e-8;
+  o.newton.abs_tolerance = 1e-8;
+  o.max_points = 5;
+  o.throw_on_failure = false;
+  try {
+    const hopf_curve_result r = trace_hopf_curve(family, 0.3, g, o);
+    ADD_FAILURE() << "traced " << r.points.size() << " points, the first with omega = " << r.points.front().omega;
+  } catch (const convergence_error& e) {
+    EXPECT_NE(std::string(e.what()).find("real eigenvalue"), std::string::npos) << e.what();
+  }
+}
