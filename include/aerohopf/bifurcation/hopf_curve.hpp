@@ -65,6 +65,18 @@
 // in omega^2, along which (mu, nu) are smooth); the curve closing on its start; stop_after
 // returning true for an accepted point (hopf_curve_stop::requested). nu_targets:
 // every crossing of a listed nu is landed exactly (a flutter boundary at given Mach numbers).
+//
+// Post-checks (those of hopf.hpp, for every accepted point): a converged corrector's
+// ||f(w, mu; nu)|| is at most the ||G|| its Newton run resolved (f is a block of G; confirmed,
+// else a failed corrector), and its omega must exceed the resolved frequency 10 ||G|| / ||p||:
+// below it omega is indistinguishable from 0 and the step is the Bogdanov-Takens end (with
+// omega_min = 0 too); a landing below it is a failed landing. The start is converged by
+// solve_hopf, whose post-checks refuse a real eigenvalue. Options and the start are checked by
+// name first (input_error). A corrector failure names the corrector's last accepted iterate
+// (||G||, nu, mu, omega); an aerohopf::error raised outside the correctors ends the trace with
+// the last point's number and coordinates: rethrown as the same type, or, with
+// throw_on_failure = false, a step_failure stop that keeps the points (a restart from
+// points.back().point() continues the curve).
 #include <Eigen/Core>
 
 #include <algorithm>

@@ -124,6 +124,11 @@
 // nu_targets, observer per accepted point, throw_on_failure = false. opt.start (hopf_options)
 // converges the start at nu0 with solve_hopf_krylov (symmetric forced). Per-point costs (GMRES
 // iterations, steady solves) are returned alongside in symmetric_hopf_curve_result::stats.
+// Post-checks and failure reports as hopf_curve.hpp, with the equilibrium check of the fixed
+// equilibrium: the w0(nu*) a converged corrector used must satisfy ||f(w0, mu*)|| <=
+// ||f(w0, mu_solved)|| + steady.abs_tolerance (it was solved at mu_solved; a family whose
+// equilibrium moves with mu fails this, and its start point is refused by solve_hopf_krylov,
+// whose equilibrium tolerance is what the start's steady solve reached + steady.abs_tolerance).
 #include <Eigen/Core>
 
 #include <algorithm>
