@@ -5,6 +5,8 @@
 #include <aerohopf/models/hopf_normal_form.hpp>
 #include <aerohopf/models/tubular_reactor.hpp>
 
+#include "support/hopf_test_systems.hpp"
+
 #include <gtest/gtest.h>
 
 using namespace aerohopf;
@@ -141,4 +143,236 @@ TEST(hopf, RejectsBadGuess) {
   EXPECT_THROW(solve_hopf(r, g), input_error);
   g.p = vec<std::complex<double>>::Ones(3);
   EXPECT_THROW(solve_hopf(r, g), input_error);
+}
+
+// ---- hostile input (tests/support/hopf_test_systems.hpp: a real eigenvalue mu, the Hopf pair
+// mu - 1 +- 2i, the equilibrium w*(mu) = c mu) ----
+namespace {
+using test_support::faulty_system;
+using test_support::moving_equilibrium_system;
+using cplx = std::complex<double>;
+
+const Eigen::Vector4d moving_c(1.0, 0.5, -0.3, 0.2);
+
+/// A guess near the real eigenvalue at mu = 0 from which Newton on the fixed-equilibrium system
+/// converges (at abs_tolerance 1e-8) to omega ~ 1e-11: the inverse-power eigenvector at
+/// (mu0, i omega0) with a fixed complex perturbation.
+template <class S>
+hopf_point real_eigenvalue_guess(const S& s, double mu0) {
+  hopf_point g = hopf_start(s, s.equilibrium(mu0), mu0, 0.3);
+  vec<cplx> q(4);
+  q << cplx(0.1, 0.7), cplx(-0.4, 0.2), cplx(0.3, -0.5), cplx(0.6, 0.1);
+  g.p += 0.3 * q;
+  return g;
+}
+
+bool same(const hopf_point& a, const hopf_point& b) {
+  return a.mu == b.mu && a.omega == b.omega && a.w.size() == b.w.size() && a.w == b.w && a.p.size() == b.p.size() &&
+         a.p == b.p;
+}
+}  // namespace
+
+// The fixed-equilibrium formulation (symmetric = true) on a system whose equilibrium moves with
+// mu: Newton on [p, mu, omega] finds the Hopf pair of A(w, mu) for the fixed w, but w is no
+// equilibrium at mu*. The full formulation gives the true point (mu* = 1, omega* = 2, w* = c).
+TEST(hopf_hostile, FixedEquilibriumRefusedWhenTheEquilibriumMovesWithMu) {
+  const moving_equilibrium_system<> s(moving_c);
+  const hopf_point g = hopf_start(s, s.equilibrium(0.9), 0.9, 1.9);  // w: the equilibrium at the guess's mu
+  const hopf_point copy = g;
+  hopf_options o;
+  o.symmetric = true;
+  try {
+    solve_hopf(s, g, o);
+    ADD_FAILURE() << "the moving equilibrium was accepted";
+  } catch (const convergence_error& e) {
+    const std::string m = e.what();
+    EXPECT_NE(m.find("equilibrium does not hold at mu*"), std::string::npos) << m;
+    EXPECT_NE(m.find("||f(w, mu*)||"), std::string::npos) << m;
+    EXPECT_NE(m.find("tolerance"), std::string::npos) << m;
+  }
+  EXPECT_TRUE(same(g, copy));
+  o.newton.throw_on_failure = false;
+  const hopf_result r = solve_hopf(s, g, o);
+  EXPECT_FALSE(r.report.converged);
+  EXPECT_NE(r.report.reason.find("equilibrium does not hold"), std::string::npos) << r.report.reason;
+  // the full formulation: the exact point
+  o.symmetric = false;
+  o.newton.throw_on_failure = true;
+  const hopf_result f = solve_hopf(s, g, o);
+  ASSERT_TRUE(f.report.converged);
+  EXPECT_NEAR(f.point.mu, 1.0, 1e-10);
+  EXPECT_NEAR(f.point.omega, 2.0, 1e-10);
+  EXPECT_LT((f.point.w - s.equilibrium(1.0)).norm(), 1e-10);
+}
+
+// w from another mu (a stale equilibrium) with the fixed-equilibrium formulation: refused.
+TEST(hopf_hostile, FixedEquilibriumRefusedForAStaleEquilibrium) {
+  const moving_equilibrium_system<> s(moving_c);
+  hopf_point g = hopf_start(s, s.equilibrium(1.0), 0.9, 1.9);
+  g.w = s.equilibrium(0.3);  // converged at mu = 0.3, used at mu ~ 1
+  hopf_options o;
+  o.symmetric = true;
+  EXPECT_THROW(solve_hopf(s, g, o), convergence_error);
+  // ... while the true equilibrium at mu* (w* = c) passes
+  g.w = s.equilibrium(1.0);
+  const hopf_result r = solve_hopf(s, g, o);
+  ASSERT_TRUE(r.report.converged);
+  EXPECT_NEAR(r.point.mu, 1.0, 1e-10);
+  EXPECT_NEAR(r.point.omega, 2.0, 1e-10);
+}
+
+// The case of the review: moving equilibrium, guess near the real eigenvalue, tolerance 1e-8.
+// Newton converges to omega ~ 1e-11 with ||f(w, mu*)|| ~ 0.2: both post-checks refuse it.
+TEST(hopf_hostile, FixedEquilibriumRefusedAtARealEigenvalueWithAMovingEquilibrium) {
+  const moving_equilibrium_system<> s(moving_c);
+  const hopf_point g = real_eigenvalue_guess(s, 0.2);
+  hopf_options o;
+  o.symmetric = true;
+  o.newton.abs_tolerance = 1e-8;
+  EXPECT_THROW(solve_hopf(s, g, o), convergence_error);
+  o.newton.throw_on_failure = false;
+  EXPECT_FALSE(solve_hopf(s, g, o).report.converged);
+}
+
+// A fixed equilibrium that is one (c = 0), guess near the real eigenvalue: Newton converges to
+// omega ~ 1e-11, which the 1e-8 tolerance does not resolve (the old guard |omega| < 1e-12 let it
+// through); the frequency guard refuses it. The Hopf point of the same system still converges
+// at that tolerance.
+TEST(hopf_hostile, UnresolvedFrequencyRefused) {
+  const moving_equilibrium_system<> s;
+  const hopf_point g = real_eigenvalue_guess(s, 0.2);
+  hopf_options o;
+  o.symmetric = true;
+  o.newton.abs_tolerance = 1e-8;
+  try {
+    solve_hopf(s, g, o);
+    ADD_FAILURE() << "an unresolved omega was accepted";
+  } catch (const convergence_error& e) {
+    const std::string m = e.what();
+    EXPECT_NE(m.find("real eigenvalue"), std::string::npos) << m;
+    EXPECT_NE(m.find("resolved frequency"), std::string::npos) << m;
+  }
+  o.newton.throw_on_failure = false;
+  const hopf_result r = solve_hopf(s, g, o);
+  EXPECT_FALSE(r.report.converged);
+  EXPECT_NE(r.report.reason.find("real eigenvalue"), std::string::npos) << r.report.reason;
+  // a correct fixed-equilibrium case
+  o.newton.throw_on_failure = true;
+  const hopf_result h = solve_hopf(s, hopf_start(s, s.equilibrium(0.0), 0.9, 1.9), o);
+  ASSERT_TRUE(h.report.converged);
+  EXPECT_NEAR(h.point.mu, 1.0, 1e-7);
+  EXPECT_NEAR(h.point.omega, 2.0, 1e-7);
+}
+
+TEST(hopf_hostile, EntryChecksNameTheInput) {
+  const moving_equilibrium_system<> s(moving_c);
+  const hopf_point good = hopf_start(s, s.equilibrium(1.0), 0.9, 1.9);
+  auto message = [&](const hopf_point& g, const hopf_options& o) -> std::string {
+    try {
+      solve_hopf(s, g, o);
+    } catch (const input_error& e) {
+      return e.what();
+    } catch (const std::exception& e) {
+      return std::string("wrong exception type: ") + e.what();
+    }
+    return "no exception";
+  };
+  const hopf_options o;
+  hopf_point g = good;
+  g.w = vec<double>::Zero(3);
+  EXPECT_NE(message(g, o).find("guess.w (equilibrium) has 3 entries, expected 4"), std::string::npos) << message(g, o);
+  g = good;
+  g.w[2] = NAN;
+  EXPECT_NE(message(g, o).find("guess.w (equilibrium) entry 2"), std::string::npos) << message(g, o);
+  g = good;
+  g.p = vec<cplx>::Ones(5);
+  EXPECT_NE(message(g, o).find("guess.p (eigenvector) has 5 entries"), std::string::npos) << message(g, o);
+  g = good;
+  g.p[1] = cplx(0, INFINITY);
+  EXPECT_NE(message(g, o).find("guess.p (eigenvector) entry 1"), std::string::npos) << message(g, o);
+  g = good;
+  g.mu = NAN;
+  EXPECT_NE(message(g, o).find("guess.mu"), std::string::npos) << message(g, o);
+  g = good;
+  g.omega = INFINITY;
+  EXPECT_NE(message(g, o).find("guess.omega"), std::string::npos) << message(g, o);
+  // options, each named
+  hopf_options b = o;
+  b.newton.abs_tolerance = NAN;
+  EXPECT_NE(message(good, b).find("newton.abs_tolerance"), std::string::npos) << message(good, b);
+  b = o;
+  b.newton.abs_tolerance = -1e-10;
+  EXPECT_NE(message(good, b).find("newton.abs_tolerance"), std::string::npos) << message(good, b);
+  b = o;
+  b.newton.abs_tolerance = 0;
+  EXPECT_NE(message(good, b).find("both 0"), std::string::npos) << message(good, b);
+  b = o;
+  b.newton.max_iterations = 0;
+  EXPECT_NE(message(good, b).find("newton.max_iterations"), std::string::npos) << message(good, b);
+  b = o;
+  b.newton.relaxation = 0;
+  EXPECT_NE(message(good, b).find("newton.relaxation"), std::string::npos) << message(good, b);
+  b = o;
+  b.newton.step_tolerance = INFINITY;
+  EXPECT_NE(message(good, b).find("newton.step_tolerance"), std::string::npos) << message(good, b);
+  b = o;
+  b.equilibrium_factor = 0.5;
+  EXPECT_NE(message(good, b).find("equilibrium_factor"), std::string::npos) << message(good, b);
+  b = o;
+  b.equilibrium_tolerance = -1;
+  EXPECT_NE(message(good, b).find("equilibrium_tolerance"), std::string::npos) << message(good, b);
+}
+
+// A residual that returns NaN at one call during the Newton iteration: the failure names the
+// solver, the last accepted iterate, its ||F||, mu and omega; the guess is untouched; with
+// throw_on_failure = false the result holds that iterate, and Newton restarted from it without
+// the fault reaches the uninjected run's point.
+TEST(hopf_hostile, NaNResidualDuringNewtonIsReportedWithTheLastGoodIterate) {
+  const moving_equilibrium_system<> clean(moving_c);
+  // a far guess (several Newton iterations): mu, omega 40 % off, the eigenvector perturbed
+  auto far_guess = [](const moving_equilibrium_system<>& s, const vec<double>& w) {
+    hopf_point h = hopf_start(s, w, 0.6, 1.2);
+    h.w = w;
+    h.p += 0.2 * vec<cplx>::Ones(4);
+    return h;
+  };
+  const hopf_point g = far_guess(clean, clean.equilibrium(0.6));
+  const hopf_point copy = g;
+  hopf_options o;
+  o.label = "injected hopf";
+  const hopf_result ref = solve_hopf(clean, g, o);
+  ASSERT_TRUE(ref.report.converged);
+  ASSERT_GE(ref.report.iterations, 3);
+  for (bool symmetric : {false, true}) {
+    hopf_options so = o;
+    so.symmetric = symmetric;
+    const moving_equilibrium_system<> base = symmetric ? moving_equilibrium_system<>() : clean;
+    const hopf_point gs = symmetric ? far_guess(base, base.equilibrium(0.0)) : g;
+    const faulty_system<moving_equilibrium_system<>> counted(base, 1L << 40);  // never faults
+    const hopf_result rs = solve_hopf(counted, gs, so);
+    ASSERT_TRUE(rs.report.converged);
+    ASSERT_GE(rs.report.iterations, 3);
+    const long at = 2 * counted.calls() / 3;  // a residual call of a later Newton iteration
+    try {
+      solve_hopf(faulty_system(base, at), gs, so);
+      ADD_FAILURE() << "no exception";
+    } catch (const convergence_error& e) {
+      const std::string m = e.what();
+      for (const char* part : {"injected hopf", "last accepted iterate", "||F|| = ", "mu = ", "omega = "})
+        EXPECT_NE(m.find(part), std::string::npos) << part << " not in: " << m;
+    }
+    hopf_options nt = so;
+    nt.newton.throw_on_failure = false;
+    const hopf_result bad = solve_hopf(faulty_system(base, at), gs, nt);
+    EXPECT_FALSE(bad.report.converged);
+    EXPECT_NE(bad.report.reason.find("last accepted iterate"), std::string::npos) << bad.report.reason;
+    ASSERT_TRUE(bad.point.w.allFinite() && bad.point.p.allFinite() && std::isfinite(bad.point.mu) &&
+                std::isfinite(bad.point.omega));
+    EXPECT_GT(std::abs(bad.point.mu - gs.mu), 0.0);  // not the guess: an iterate Newton had reached
+    const hopf_result again = solve_hopf(base, bad.point, so);
+    ASSERT_TRUE(again.report.converged);
+    EXPECT_NEAR(again.point.mu, rs.point.mu, 1e-10);
+    EXPECT_NEAR(again.point.omega, rs.point.omega, 1e-10);
+  }
+  EXPECT_TRUE(same(g, copy));
 }

@@ -12,6 +12,8 @@
 #include <aerohopf/flow/naca_cgrid.hpp>
 #include <aerohopf/models/aerofoil.hpp>
 
+#include "support/hopf_test_systems.hpp"
+
 #include <complex>
 #include <cstdlib>
 #include <iostream>
@@ -189,4 +191,187 @@ TEST(hopf_bordered, refuses_bad_input) {
   EXPECT_THROW((prolong_cells<2, double>(f.s.flow().grid().topology, f.s.flow().grid().topology, 2,
                                          vec<double>::Zero(f.s.flow_size()), 4)),
                input_error);
+}
+
+// ---- hostile input on the small systems of tests/support/hopf_test_systems.hpp (real
+// eigenvalue mu, Hopf pair mu - 1 +- 2i, equilibrium w*(mu) = c mu), for the complex bordering
+// (dense LU) and the Krylov solver (sparse Jacobian, B = 2) ----
+namespace {
+using test_support::faulty_system;
+using test_support::moving_equilibrium_system;
+using dense_sys = moving_equilibrium_system<Eigen::MatrixXd>;
+using sparse_sys = moving_equilibrium_system<Eigen::SparseMatrix<double>>;
+const Eigen::Vector4d moving_c(1.0, 0.5, -0.3, 0.2);
+
+hopf_options fixed_options(double tol = 1e-10) {
+  hopf_options o;
+  o.symmetric = true;
+  o.newton.abs_tolerance = tol;
+  return o;
+}
+
+/// Both bordered solvers on system type D (dense, bordering) and Sp (sparse, Krylov).
+template <class D, class Sp>
+std::pair<hopf_result, hopf_result> both(const D& d, const Sp& sp, const hopf_point& g, const hopf_options& o,
+                                         const hopf_krylov_options& ko = {}) {
+  direct_solver<Eigen::MatrixXcd> lu;
+  hopf_result a = solve_hopf_bordered(d, g, o, lu);
+  hopf_result b = solve_hopf_krylov<2>(sp, g, o, ko);
+  return {std::move(a), std::move(b)};
+}
+
+/// Guess near the real eigenvalue at mu = 0 (Newton converges to omega ~ 1e-11 at tolerance 1e-8).
+hopf_point real_eigenvalue_guess(const dense_sys& s, double mu0) {
+  hopf_point g = hopf_start(s, s.equilibrium(mu0), mu0, 0.3);
+  vec<cplx> q(4);
+  q << cplx(0.1, 0.7), cplx(-0.4, 0.2), cplx(0.3, -0.5), cplx(0.6, 0.1);
+  g.p += 0.3 * q;
+  return g;
+}
+}  // namespace
+
+TEST(hopf_bordered_hostile, moving_or_stale_equilibrium_is_refused) {
+  const dense_sys d(moving_c);
+  const sparse_sys sp(moving_c);
+  for (double mu_w : {0.9, 0.3}) {  // the equilibrium at the guess's mu, and a stale one
+    hopf_point g = hopf_start(d, d.equilibrium(1.0), 0.9, 1.9);
+    g.w = d.equilibrium(mu_w);
+    const hopf_point copy = g;
+    hopf_options o = fixed_options();
+    direct_solver<Eigen::MatrixXcd> lu;
+    try {
+      solve_hopf_bordered(d, g, o, lu);
+      ADD_FAILURE() << "bordered: accepted";
+    } catch (const convergence_error& e) {
+      EXPECT_NE(std::string(e.what()).find("equilibrium does not hold at mu*"), std::string::npos) << e.what();
+    }
+    try {
+      solve_hopf_krylov<2>(sp, g, o);
+      ADD_FAILURE() << "krylov: accepted";
+    } catch (const convergence_error& e) {
+      EXPECT_NE(std::string(e.what()).find("equilibrium does not hold at mu*"), std::string::npos) << e.what();
+    }
+    o.newton.throw_on_failure = false;
+    const auto [a, b] = both(d, sp, g, o);
+    EXPECT_FALSE(a.report.converged);
+    EXPECT_FALSE(b.report.converged);
+    EXPECT_NE(b.report.reason.find("||f(w, mu*)||"), std::string::npos) << b.report.reason;
+    EXPECT_EQ(g.w, copy.w);
+    EXPECT_EQ(g.p, copy.p);
+  }
+  // the same guess with the true equilibrium at mu* = 1 (w* = c) converges in both
+  hopf_point g = hopf_start(d, d.equilibrium(1.0), 0.9, 1.9);
+  const auto [a, b] = both(d, sp, g, fixed_options());
+  ASSERT_TRUE(a.report.converged);
+  ASSERT_TRUE(b.report.converged);
+  EXPECT_NEAR(a.point.mu, 1.0, 1e-10);
+  EXPECT_NEAR(b.point.mu, 1.0, 1e-10);
+  EXPECT_NEAR(a.point.omega, 2.0, 1e-10);
+  EXPECT_NEAR(b.point.omega, 2.0, 1e-10);
+}
+
+TEST(hopf_bordered_hostile, unresolved_frequency_is_refused) {
+  const dense_sys d;
+  const sparse_sys sp;
+  const hopf_point g = real_eigenvalue_guess(d, 0.2);
+  hopf_options o = fixed_options(1e-8);
+  o.newton.throw_on_failure = false;
+  hopf_krylov_options ko;
+  ko.reuse_matrices = false;
+  const auto [a, b] = both(d, sp, g, o, ko);
+  EXPECT_FALSE(a.report.converged) << "omega " << a.point.omega;
+  EXPECT_FALSE(b.report.converged) << "omega " << b.point.omega;
+  EXPECT_NE(a.report.reason.find("real eigenvalue"), std::string::npos) << a.report.reason;
+  EXPECT_NE(b.report.reason.find("real eigenvalue"), std::string::npos) << b.report.reason;
+  o.newton.throw_on_failure = true;
+  direct_solver<Eigen::MatrixXcd> lu;
+  EXPECT_THROW(solve_hopf_bordered(d, g, o, lu), convergence_error);
+  EXPECT_THROW(solve_hopf_krylov<2>(sp, g, o, ko), convergence_error);
+}
+
+TEST(hopf_bordered_hostile, nan_residual_is_reported_with_the_last_good_iterate) {
+  const dense_sys d;
+  const sparse_sys sp;
+  hopf_point g = hopf_start(d, d.equilibrium(0.0), 0.6, 1.2);
+  g.p += 0.2 * vec<cplx>::Ones(4);
+  const hopf_point copy = g;
+  hopf_options o = fixed_options();
+  o.label = "injected bordered";
+  const auto [ra, rb] = both(d, sp, g, o);
+  ASSERT_TRUE(ra.report.converged);
+  ASSERT_TRUE(rb.report.converged);
+  ASSERT_GE(rb.report.iterations, 3);
+  // each residual evaluation is two taylor products: call 5 is the residual at iterate 2
+  direct_solver<Eigen::MatrixXcd> lu;
+  const auto check = [&](const std::string& m) {
+    for (const char* part : {"injected bordered", "last accepted iterate", "||F|| = ", "mu = ", "omega = "})
+      EXPECT_NE(m.find(part), std::string::npos) << part << " not in: " << m;
+  };
+  try {
+    solve_hopf_bordered(faulty_system(d, 5), g, o, lu);
+    ADD_FAILURE() << "bordered: no exception";
+  } catch (const convergence_error& e) {
+    check(e.what());
+  }
+  try {
+    solve_hopf_krylov<2>(faulty_system(sp, 5), g, o);
+    ADD_FAILURE() << "krylov: no exception";
+  } catch (const convergence_error& e) {
+    check(e.what());
+  }
+  o.newton.throw_on_failure = false;
+  const hopf_result bad = solve_hopf_krylov<2>(faulty_system(sp, 5), g, o);
+  EXPECT_FALSE(bad.report.converged);
+  check(bad.report.reason);
+  ASSERT_TRUE(bad.point.p.allFinite() && std::isfinite(bad.point.mu) && std::isfinite(bad.point.omega));
+  o.newton.throw_on_failure = true;
+  const hopf_result again = solve_hopf_krylov<2>(sp, bad.point, o);
+  EXPECT_NEAR(again.point.mu, rb.point.mu, 1e-10);
+  EXPECT_NEAR(again.point.omega, rb.point.omega, 1e-10);
+  EXPECT_EQ(g.p, copy.p);
+  EXPECT_EQ(g.mu, copy.mu);
+}
+
+TEST(hopf_bordered_hostile, krylov_options_are_checked) {
+  const sparse_sys sp;
+  const hopf_point g = hopf_start(sp, sp.equilibrium(0.0), 0.9, 1.9);
+  const hopf_options o = fixed_options();
+  auto message = [&](const hopf_krylov_options& ko) -> std::string {
+    try {
+      solve_hopf_krylov<2>(sp, g, o, ko);
+    } catch (const input_error& e) {
+      return e.what();
+    } catch (const std::exception& e) {
+      return std::string("wrong exception type: ") + e.what();
+    }
+    return "no exception";
+  };
+  hopf_krylov_options k;
+  k.fill_level = -1;
+  EXPECT_NE(message(k).find("fill_level"), std::string::npos) << message(k);
+  k = {};
+  k.eta_max = 0;
+  EXPECT_NE(message(k).find("eta_max"), std::string::npos) << message(k);
+  k = {};
+  k.forcing_exponent = NAN;
+  EXPECT_NE(message(k).find("forcing_exponent"), std::string::npos) << message(k);
+  k = {};
+  k.start_tolerance = 1.5;
+  EXPECT_NE(message(k).find("start_tolerance"), std::string::npos) << message(k);
+  k = {};
+  k.reuse_window = -1;
+  EXPECT_NE(message(k).find("reuse_window"), std::string::npos) << message(k);
+  k = {};
+  k.start_max_iterations = 0;
+  EXPECT_NE(message(k).find("start_max_iterations"), std::string::npos) << message(k);
+  hopf_options bad = o;
+  bad.newton.max_iterations = -3;
+  direct_solver<Eigen::MatrixXcd> lu;
+  const dense_sys d;
+  EXPECT_THROW(solve_hopf_bordered(d, g, bad, lu), input_error);
+  EXPECT_THROW(solve_hopf_krylov<2>(sp, g, bad), input_error);
+  hopf_point short_w = g;
+  short_w.w = vec<double>::Zero(2);
+  EXPECT_THROW(solve_hopf_krylov<2>(sp, short_w, o), input_error);
+  EXPECT_THROW(solve_hopf_bordered(d, short_w, o, lu), input_error);
 }

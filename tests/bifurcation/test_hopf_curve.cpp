@@ -10,6 +10,8 @@
 #include <aerohopf/bifurcation.hpp>
 #include <aerohopf/models/tubular_reactor.hpp>
 
+#include "support/hopf_test_systems.hpp"
+
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>
@@ -385,5 +387,198 @@ TEST(hopf_curve, step_failure_is_reported_with_the_last_point) {
   for (const auto& pt : r.points) {
     EXPECT_LE(pt.nu, 0.9);
     EXPECT_LT(std::abs(pt.mu * pt.mu + pt.nu * pt.nu - 1), 1e-8);
+  }
+}
+
+// ---- hostile input ----
+namespace {
+using test_support::faulty_system;
+using circle_fault = faulty_system<synthetic_system>;
+
+/// The circle family with a residual that returns NaN from call `at` on (`count` calls), one
+/// call counter for all its members.
+auto faulty_circle(std::shared_ptr<long> counter, long at, long count) {
+  return [=](double nu) { return circle_fault(synthetic_system(synthetic_system::circle, nu), counter, at, count); };
+}
+
+hopf_curve_options circle_trace_options() {
+  hopf_curve_options o;
+  o.step = 0.05;
+  o.max_step = 0.2;
+  o.min_step = 1e-4;
+  o.nu_targets = {0.8};
+  o.nu_max = 0.9;
+  return o;
+}
+
+const hopf_curve_point* landed_at(const hopf_curve_result& r, double nu) {
+  for (const auto& p : r.points)
+    if (p.landed && std::abs(p.nu - nu) < 1e-12) return &p;
+  return nullptr;
+}
+}  // namespace
+
+TEST(hopf_curve_hostile, options_and_start_are_checked_by_name) {
+  auto family = [](double nu) { return synthetic_system(synthetic_system::circle, nu); };
+  const hopf_point start = synthetic_start(synthetic_system::circle, 0.6, 0.78, 1.2);
+  const hopf_curve_options good = circle_trace_options();
+  auto message = [&](const hopf_curve_options& o, const hopf_point& s) -> std::string {
+    try {
+      trace_hopf_curve(family, 0.6, s, o);
+    } catch (const input_error& e) {
+      return e.what();
+    } catch (const std::exception& e) {
+      return std::string("wrong exception type: ") + e.what();
+    }
+    return "no exception";
+  };
+  auto expect = [&](const hopf_curve_options& o, const hopf_point& s, const char* part) {
+    const std::string m = message(o, s);
+    EXPECT_NE(m.find(part), std::string::npos) << part << " not in: " << m;
+    EXPECT_NE(m.find(o.label), std::string::npos) << m;
+  };
+  hopf_curve_options o = good;
+  o.nu_targets = {0.7, NAN};
+  expect(o, start, "nu_targets entry 1");
+  o = good;
+  o.max_points = 0;
+  expect(o, start, "max_points");
+  o = good;
+  o.step = INFINITY;
+  expect(o, start, "step sizes");
+  o = good;
+  o.min_cosine = 2;
+  expect(o, start, "min_cosine");
+  o = good;
+  o.omega_min = NAN;
+  expect(o, start, "omega_min");
+  o = good;
+  o.corrector_distance = 0;
+  expect(o, start, "corrector_distance");
+  o = good;
+  o.growth = INFINITY;
+  expect(o, start, "growth");
+  o = good;
+  o.newton.abs_tolerance = NAN;
+  expect(o, start, "newton.abs_tolerance");
+  o = good;
+  o.newton.max_iterations = 0;
+  expect(o, start, "newton.max_iterations");
+  o = good;
+  o.mu_min = 1, o.mu_max = 0;
+  expect(o, start, "mu_min <= mu_max");
+  hopf_point s = start;
+  s.w = s.w.head(3).eval();
+  expect(good, s, "start.w (equilibrium at nu0) has 3 entries");
+  s = start;
+  s.p[2] = std::complex<double>(NAN, 0);
+  expect(good, s, "start.p (eigenvector) entry 2");
+}
+
+// A residual that returns NaN once during the trace: the corrector that meets it fails, the
+// step is retried, and the trace goes on to the same landed point as the uninjected one.
+TEST(hopf_curve_hostile, a_transient_nan_is_survived) {
+  const hopf_point start = synthetic_start(synthetic_system::circle, 0.6, 0.78, 1.2);
+  const hopf_curve_options o = circle_trace_options();
+  auto clean_counter = std::make_shared<long>(0);
+  const hopf_curve_result ref = trace_hopf_curve(faulty_circle(clean_counter, 1L << 40, 0), 0.6, start, o);
+  const hopf_curve_point* ref_land = landed_at(ref, 0.8);
+  ASSERT_NE(ref_land, nullptr);
+  auto counter = std::make_shared<long>(0);
+  const hopf_curve_result r = trace_hopf_curve(faulty_circle(counter, *clean_counter / 2, 1), 0.6, start, o);
+  EXPECT_GE(r.failed_correctors, 1);
+  const hopf_curve_point* land = landed_at(r, 0.8);
+  ASSERT_NE(land, nullptr);
+  EXPECT_NEAR(land->mu, ref_land->mu, 1e-9);
+  EXPECT_NEAR(land->omega, ref_land->omega, 1e-9);
+  EXPECT_NEAR(land->mu, 0.6, 1e-9);  // closed form: mu^2 + nu^2 = 1
+}
+
+// From some call on the residual is NaN for good: the trace reports where and why it stopped
+// (label, last point, and the corrector's last accepted iterate with ||F||, nu, mu, omega),
+// keeps the points accepted so far (throw_on_failure = false) or throws convergence_error with
+// the same context; the caller's start and options are untouched; restarting from the last
+// accepted point without the fault lands on the same point as the uninjected trace.
+TEST(hopf_curve_hostile, a_persistent_nan_stops_the_trace_with_context_and_it_restarts) {
+  const hopf_point start = synthetic_start(synthetic_system::circle, 0.6, 0.78, 1.2);
+  const hopf_point start_copy = start;
+  hopf_curve_options o = circle_trace_options();
+  o.label = "injected curve";
+  // the call count when point 2 is accepted, from an uninjected run with the same counter
+  auto clean_counter = std::make_shared<long>(0);
+  long calls_at_point2 = -1;
+  hopf_curve_options counting = o;
+  int seen = 0;
+  counting.observer = [&](const hopf_curve_point&) {
+    if (++seen == 3) calls_at_point2 = *clean_counter;
+  };
+  const hopf_curve_result ref = trace_hopf_curve(faulty_circle(clean_counter, 1L << 40, 0), 0.6, start, counting);
+  const hopf_curve_point* ref_land = landed_at(ref, 0.8);
+  ASSERT_NE(ref_land, nullptr);
+  ASSERT_GT(calls_at_point2, 0);
+  ASSERT_LT(ref.points[2].nu, 0.8);
+
+  const long at = calls_at_point2 + 1;
+  o.throw_on_failure = false;
+  const hopf_curve_options o_copy = o;
+  auto counter = std::make_shared<long>(0);
+  const hopf_curve_result r = trace_hopf_curve(faulty_circle(counter, at, 1L << 40), 0.6, start, o);
+  EXPECT_EQ(r.stop, hopf_curve_stop::step_failure);
+  ASSERT_EQ(r.points.size(), 3u);
+  for (const auto& pt : r.points) EXPECT_LT(std::abs(pt.mu * pt.mu + pt.nu * pt.nu - 1), 1e-8);
+  for (const char* part : {"injected curve", "point 2", "not finite", "last accepted iterate", "||F|| = ", "nu = ",
+                           "mu = ", "omega = "})
+    EXPECT_NE(r.stop_reason.find(part), std::string::npos) << part << " not in: " << r.stop_reason;
+  o.throw_on_failure = true;
+  try {
+    auto c2 = std::make_shared<long>(0);
+    trace_hopf_curve(faulty_circle(c2, at, 1L << 40), 0.6, start, o);
+    ADD_FAILURE() << "no exception";
+  } catch (const convergence_error& e) {
+    const std::string m = e.what();
+    EXPECT_NE(m.find("last accepted iterate"), std::string::npos) << m;
+    EXPECT_NE(m.find("injected curve"), std::string::npos) << m;
+  }
+  // inputs untouched
+  EXPECT_EQ(start.w, start_copy.w);
+  EXPECT_EQ(start.p, start_copy.p);
+  EXPECT_EQ(start.mu, start_copy.mu);
+  EXPECT_EQ(start.omega, start_copy.omega);
+  EXPECT_EQ(o_copy.step, o.step);
+  EXPECT_EQ(o_copy.nu_targets, o.nu_targets);
+  // restart from the last accepted point, no fault
+  o.throw_on_failure = true;
+  auto family = [](double nu) { return synthetic_system(synthetic_system::circle, nu); };
+  const hopf_curve_point& last = r.points.back();
+  const hopf_curve_result again = trace_hopf_curve(family, last.nu, last.point(), o);
+  const hopf_curve_point* land = landed_at(again, 0.8);
+  ASSERT_NE(land, nullptr);
+  EXPECT_NEAR(land->mu, ref_land->mu, 1e-9);
+  EXPECT_NEAR(land->omega, ref_land->omega, 1e-9);
+}
+
+// A start at the real eigenvalue mu = 0 of a family (tests/support/hopf_test_systems.hpp) with
+// omega_min = 0 and tolerances 1e-8: solve_hopf converges to omega ~ 1e-11, which that
+// tolerance does not resolve. Refused, instead of tracing the fold line mu = 0 as "Hopf points".
+TEST(hopf_curve_hostile, a_start_at_a_real_eigenvalue_is_refused) {
+  using test_support::moving_equilibrium_system;
+  using cplx = std::complex<double>;
+  auto family = [](double nu) { return moving_equilibrium_system<>(Eigen::Vector4d(nu, 0.5 * nu, 0, 0)); };
+  const auto s0 = family(0.3);
+  hopf_point g = hopf_start(s0, s0.equilibrium(0.2), 0.2, 0.3);
+  vec<cplx> q(4);
+  q << cplx(0.1, 0.7), cplx(-0.4, 0.2), cplx(0.3, -0.5), cplx(0.6, 0.1);
+  g.p += 0.3 * q;
+  hopf_curve_options o;
+  o.omega_min = 0;
+  o.start.newton.abs_tolerance = 1e-8;
+  o.newton.abs_tolerance = 1e-8;
+  o.max_points = 5;
+  o.throw_on_failure = false;
+  try {
+    const hopf_curve_result r = trace_hopf_curve(family, 0.3, g, o);
+    ADD_FAILURE() << "traced " << r.points.size() << " points, the first with omega = " << r.points.front().omega;
+  } catch (const convergence_error& e) {
+    EXPECT_NE(std::string(e.what()).find("real eigenvalue"), std::string::npos) << e.what();
   }
 }

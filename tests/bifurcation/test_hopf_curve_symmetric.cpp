@@ -16,6 +16,7 @@
 #include <gtest/gtest.h>
 
 #include "support/aerofoil_cases.hpp"
+#include "support/hopf_test_systems.hpp"
 
 #include <Eigen/Dense>
 #include <Eigen/SparseCore>
@@ -494,4 +495,140 @@ TEST(hopf_curve_symmetric, aerofoil_heavy_very_coarse_matches_fixed_mach_hopf_so
   EXPECT_NEAR(atj->mu, h.point.mu, 1e-8);
   EXPECT_NEAR(atj->omega, h.point.omega, 1e-8);
   EXPECT_LT((atj->w - w1).lpNorm<Eigen::Infinity>(), 1e-8);
+}
+
+// ---- hostile input ----
+namespace {
+using test_support::faulty_system;
+using test_support::mu_shifted_system;
+
+auto faulty_circle_family(std::shared_ptr<long> counter, long at, long count) {
+  return [=](double nu) { return faulty_system<circle_family_system>(circle_family_system(nu), counter, at, count); };
+}
+
+hopf_curve_options quiet_circle_options() {
+  hopf_curve_options o = circle_options();
+  o.verbose = false;
+  o.min_step = 1e-3;
+  return o;
+}
+
+const hopf_curve_point* landed_at(const std::vector<hopf_curve_point>& pts, double nu, double mu_sign) {
+  for (const auto& p : pts)
+    if (p.landed && std::abs(p.nu - nu) < 1e-12 && p.mu * mu_sign > 0) return &p;
+  return nullptr;
+}
+}  // namespace
+
+TEST(hopf_curve_symmetric_hostile, options_are_checked_by_name) {
+  auto family = [](double nu) { return circle_family_system(nu); };
+  const hopf_point start = circle_start(0.6, 0.78, 1.2);
+  auto message = [&](const hopf_curve_options& o, const symmetric_hopf_curve_options& so,
+                     const hopf_point& s) -> std::string {
+    try {
+      trace_symmetric_hopf_curve<2>(family, 0.6, s, o, 1, so);
+    } catch (const input_error& e) {
+      return e.what();
+    } catch (const std::exception& e) {
+      return std::string("wrong exception type: ") + e.what();
+    }
+    return "no exception";
+  };
+  const hopf_curve_options good = quiet_circle_options();
+  const symmetric_hopf_curve_options sgood;
+  auto expect = [&](const hopf_curve_options& o, const symmetric_hopf_curve_options& so, const hopf_point& s,
+                    const char* part) {
+    const std::string m = message(o, so, s);
+    EXPECT_NE(m.find(part), std::string::npos) << part << " not in: " << m;
+  };
+  hopf_curve_options o = good;
+  o.nu_targets = {NAN};
+  expect(o, sgood, start, "nu_targets entry 0");
+  o = good;
+  o.min_cosine = -2;
+  expect(o, sgood, start, "min_cosine");
+  o = good;
+  o.newton.rel_tolerance = -1;
+  expect(o, sgood, start, "newton.rel_tolerance");
+  o = good;
+  o.start.newton.abs_tolerance = NAN;
+  expect(o, sgood, start, "newton.abs_tolerance");
+  symmetric_hopf_curve_options so = sgood;
+  so.kink_distance = 0;
+  expect(good, so, start, "kink_distance");
+  so = sgood;
+  so.steady.relaxation = 2;
+  expect(good, so, start, "steady.relaxation");
+  hopf_point s = start;
+  s.w[1] = NAN;
+  expect(good, sgood, s, "start.w (equilibrium at nu0) entry 1");
+  s = start;
+  s.p = s.p.head(5).eval();
+  expect(good, sgood, s, "start.p (eigenvector) has 5 entries");
+}
+
+// A family whose equilibrium moves with mu: the symmetric tracer's fixed-equilibrium Hopf
+// system cannot follow it; the start point is refused (the equilibrium solved at the guess's mu
+// does not hold at mu*) instead of tracing a curve of non-equilibria.
+TEST(hopf_curve_symmetric_hostile, an_equilibrium_that_moves_with_mu_is_refused) {
+  const vec<double> c = vec<double>::LinSpaced(circle_family_system::n, 0.2, -0.3);
+  auto family = [c](double nu) { return mu_shifted_system<circle_family_system>(circle_family_system(nu), c); };
+  hopf_point start = circle_start(0.6, 0.78, 1.2);
+  start.w += c * start.mu;
+  try {
+    const auto r = trace_symmetric_hopf_curve<2>(family, 0.6, start, quiet_circle_options());
+    ADD_FAILURE() << "traced " << r.points.size() << " points of a moving equilibrium";
+  } catch (const convergence_error& e) {
+    EXPECT_NE(std::string(e.what()).find("equilibrium does not hold"), std::string::npos) << e.what();
+  }
+}
+
+// NaN from some call on for good: the trace stops with step_failure keeping the points accepted
+// so far, the reason names the tracer, the point and the corrector's last accepted iterate;
+// restarted from the last point without the fault, it lands on the same point as the
+// uninjected trace. A single NaN is survived (same landed point).
+TEST(hopf_curve_symmetric_hostile, nan_residual_stops_with_context_and_the_trace_restarts) {
+  const hopf_point start = circle_start(0.6, 0.78, 1.2);
+  const hopf_point start_copy = start;
+  hopf_curve_options o = quiet_circle_options();
+  o.label = "injected symmetric curve";
+  auto clean = std::make_shared<long>(0);
+  long calls_at_point2 = -1;
+  int seen = 0;
+  hopf_curve_options counting = o;
+  counting.observer = [&](const hopf_curve_point&) {
+    if (++seen == 3) calls_at_point2 = *clean;
+  };
+  const auto ref = trace_symmetric_hopf_curve<2>(faulty_circle_family(clean, 1L << 40, 0), 0.6, start, counting);
+  const hopf_curve_point* ref_land = landed_at(ref.points, 0.8, +1);
+  ASSERT_NE(ref_land, nullptr);
+  ASSERT_GT(calls_at_point2, 0);
+  ASSERT_LT(ref.points[2].nu, 0.8);
+
+  auto once = std::make_shared<long>(0);
+  const auto survived = trace_symmetric_hopf_curve<2>(faulty_circle_family(once, calls_at_point2 + 3, 1), 0.6, start, o);
+  const hopf_curve_point* s_land = landed_at(survived.points, 0.8, +1);
+  ASSERT_NE(s_land, nullptr);
+  EXPECT_NEAR(s_land->mu, ref_land->mu, 1e-9);
+  EXPECT_NEAR(s_land->omega, ref_land->omega, 1e-9);
+
+  o.throw_on_failure = false;
+  auto counter = std::make_shared<long>(0);
+  const auto r = trace_symmetric_hopf_curve<2>(faulty_circle_family(counter, calls_at_point2 + 1, 1L << 40), 0.6, start, o);
+  EXPECT_EQ(r.stop, hopf_curve_stop::step_failure);
+  ASSERT_EQ(r.points.size(), 3u);
+  for (const char* part : {"injected symmetric curve", "point 2", "last accepted iterate", "||F|| = ", "nu = ", "mu = ",
+                           "omega = "})
+    EXPECT_NE(r.stop_reason.find(part), std::string::npos) << part << " not in: " << r.stop_reason;
+  EXPECT_EQ(start.w, start_copy.w);
+  EXPECT_EQ(start.p, start_copy.p);
+  EXPECT_EQ(start.mu, start_copy.mu);
+  o.throw_on_failure = true;
+  auto family = [](double nu) { return circle_family_system(nu); };
+  const hopf_curve_point& last = r.points.back();
+  const auto again = trace_symmetric_hopf_curve<2>(family, last.nu, last.point(), o);
+  const hopf_curve_point* land = landed_at(again.points, 0.8, +1);
+  ASSERT_NE(land, nullptr);
+  EXPECT_NEAR(land->mu, ref_land->mu, 1e-9);
+  EXPECT_NEAR(land->omega, ref_land->omega, 1e-9);
 }

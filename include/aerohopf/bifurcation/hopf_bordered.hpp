@@ -85,10 +85,8 @@ struct symmetric_hopf_problem {
                          vec<double>& y0)
       : sys(system), w(guess.w), n(system.size()), N(2 * system.size() + 2) {
     require(opt.symmetric, who, ": only the symmetric (fixed equilibrium) system is implemented; set hopf_options::symmetric");
-    check_state(sys, guess.w, guess.mu, who);
-    require(guess.p.size() == n, who, ": eigenvector has ", guess.p.size(), " entries, system ", n);
-    require(guess.p.allFinite() && guess.p.norm() > 0, who, ": eigenvector is zero or not finite");
-    require(std::isfinite(guess.omega) && std::isfinite(guess.mu), who, ": mu or omega is not finite");
+    check_hopf_guess(sys, guess, who);
+    check_hopf_options(opt, who);
     vec<std::complex<double>> p0 = guess.p;
     s = hopf_normalise(p0, resolve_normalisation<jacobian_t<S>>(opt.normalisation));
     y0.resize(N);
@@ -120,6 +118,8 @@ struct symmetric_hopf_problem {
     };
   }
 
+  /// The converged point with omega > 0, after the post-checks of hopf.hpp (w is fixed: the
+  /// equilibrium is verified at mu*).
   hopf_result result(newton_result&& nr, long linear_iterations, const hopf_options& opt) const {
     hopf_result res;
     res.s = s;
@@ -136,9 +136,7 @@ struct symmetric_hopf_problem {
       res.point.omega = -res.point.omega;
       res.point.p = res.point.p.conjugate().eval();
     }
-    if (res.report.converged && std::abs(res.point.omega) < 1e-12 * (1 + std::abs(res.point.mu)) &&
-        opt.newton.throw_on_failure)
-      throw convergence_error(opt.label + ": converged to omega = 0 (a real eigenvalue: divergence, not Hopf)");
+    hopf_accept(sys, res, opt, true);
     return res;
   }
 };
@@ -238,7 +236,9 @@ hopf_result solve_hopf_bordered(const S& sys, const hopf_point& guess, const hop
   auto count = [&] {
     if constexpr (requires { solver.last_report().iterations; }) linear_iterations += solver.last_report().iterations;
   };
+  internal::hopf_iterate_log last(x, N - 2, N - 1);
   auto step = [&](const vec<double>& y, const vec<double>& f, int it) {
+    last.record(y, f, it);
     const double mu = y[N - 2], om = y[N - 1];
     vec<C> p(n), g(n);
     p.real() = y.head(n);
@@ -278,7 +278,8 @@ hopf_result solve_hopf_bordered(const S& sys, const hopf_point& guess, const hop
   };
   newton_options nopt = opt.newton;
   prob.add_progress(nopt, opt, linear_iterations);
-  newton_result nr = newton_iterate(residual, step, x, nopt, opt.label + " (bordered Hopf system)");
+  newton_result nr = internal::run_hopf_newton(
+      [&] { return newton_iterate(residual, step, x, nopt, opt.label + " (bordered Hopf system)"); }, last, opt);
   return prob.result(std::move(nr), linear_iterations, opt);
 }
 
@@ -382,6 +383,30 @@ struct hopf_krylov_options {
   double start_residual_threshold = 0.0;
 };
 
+namespace internal {
+/// Throws input_error naming the offending option of solve_hopf_krylov.
+inline void check_hopf_krylov_options(const hopf_krylov_options& k, const std::string& where) {
+  require(k.fill_level >= 0, where, ": fill_level must be >= 0 (got ", k.fill_level, ")");
+  require(k.eta_max > 0 && k.eta_max < 1, where, ": eta_max must lie in (0, 1) (got ", k.eta_max, ")");
+  require(std::isfinite(k.forcing_exponent) && k.forcing_exponent > 0, where,
+          ": forcing_exponent must be finite and > 0 (got ", k.forcing_exponent, ")");
+  require(k.krylov.relative_tolerance >= 0 && k.krylov.relative_tolerance < 1, where,
+          ": krylov.relative_tolerance must lie in [0, 1) (got ", k.krylov.relative_tolerance, ")");
+  require(k.krylov.max_iterations >= 1 && k.krylov.restart >= 1, where,
+          ": krylov.max_iterations and krylov.restart must be >= 1 (got ", k.krylov.max_iterations, ", ",
+          k.krylov.restart, ")");
+  require(std::isfinite(k.reuse_window) && k.reuse_window >= 0, where,
+          ": reuse_window must be finite and >= 0 (got ", k.reuse_window, ")");
+  require(k.start_iterations >= 0, where, ": start_iterations must be >= 0 (got ", k.start_iterations, ")");
+  require(k.start_tolerance > 0 && k.start_tolerance < 1, where, ": start_tolerance must lie in (0, 1) (got ",
+          k.start_tolerance, ")");
+  require(k.start_max_iterations >= 1, where, ": start_max_iterations must be >= 1 (got ", k.start_max_iterations,
+          ")");
+  require(std::isfinite(k.start_residual_threshold) && k.start_residual_threshold >= 0, where,
+          ": start_residual_threshold must be finite and >= 0 (got ", k.start_residual_threshold, ")");
+}
+}  // namespace internal
+
 /// Newton on the symmetric Hopf system with the exact bordered matrix, GMRES and the bordered
 /// complex-BILU(k) preconditioner of the modified-order matrix (file comment). B is the block
 /// size of the system's unknowns (4 for 2D Euler + pitch-plunge); n must be a multiple of B or
@@ -397,6 +422,7 @@ hopf_result solve_hopf_krylov(const S& sys, const hopf_point& guess, const hopf_
   // validates the guess (sizes, finiteness, symmetric option); rebuilt below if the start is refined
   std::optional<internal::symmetric_hopf_problem<S>> prob_storage;
   prob_storage.emplace(sys, guess, opt, "solve_hopf_krylov", x);
+  internal::check_hopf_krylov_options(kopt, "solve_hopf_krylov");
   const Eigen::Index n = prob_storage->n, N = prob_storage->N;
   const vec<double>& w = guess.w;  // the equilibrium (prob.w is a copy)
   double setup_seconds = 0, linear_seconds = 0, residual_seconds = 0;
@@ -491,7 +517,9 @@ hopf_result solve_hopf_krylov(const S& sys, const hopf_point& guess, const hopf_
     return f;
   };
   long linear_iterations = start_linear_iterations;
+  internal::hopf_iterate_log last(x, N - 2, N - 1);
   auto step = [&](const vec<double>& y, const vec<double>& f, int it) {
+    last.record(y, f, it);
     const double mu = y[N - 2], om = y[N - 1];
     const vec<double> pr = y.head(n), pi = y.segment(n, n);
     const double fn = f.norm();
@@ -530,7 +558,8 @@ hopf_result solve_hopf_krylov(const S& sys, const hopf_point& guess, const hopf_
   };
   newton_options nopt = opt.newton;
   prob.add_progress(nopt, opt, linear_iterations);
-  newton_result nr = newton_iterate(residual, step, x, nopt, opt.label + " (Hopf system, BILU-GMRES)");
+  newton_result nr = internal::run_hopf_newton(
+      [&] { return newton_iterate(residual, step, x, nopt, opt.label + " (Hopf system, BILU-GMRES)"); }, last, opt);
   hopf_result res = prob.result(std::move(nr), linear_iterations, opt);
   res.setup_seconds = setup_seconds;
   res.linear_seconds = linear_seconds;

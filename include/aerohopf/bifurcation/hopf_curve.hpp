@@ -65,6 +65,18 @@
 // in omega^2, along which (mu, nu) are smooth); the curve closing on its start; stop_after
 // returning true for an accepted point (hopf_curve_stop::requested). nu_targets:
 // every crossing of a listed nu is landed exactly (a flutter boundary at given Mach numbers).
+//
+// Post-checks (those of hopf.hpp, for every accepted point): a converged corrector's
+// ||f(w, mu; nu)|| is at most the ||G|| its Newton run resolved (f is a block of G; confirmed,
+// else a failed corrector), and its omega must exceed the resolved frequency 10 ||G|| / ||p||:
+// below it omega is indistinguishable from 0 and the step is the Bogdanov-Takens end (with
+// omega_min = 0 too); a landing below it is a failed landing. The start is converged by
+// solve_hopf, whose post-checks refuse a real eigenvalue. Options and the start are checked by
+// name first (input_error). A corrector failure names the corrector's last accepted iterate
+// (||G||, nu, mu, omega); an aerohopf::error raised outside the correctors ends the trace with
+// the last point's number and coordinates: rethrown as the same type, or, with
+// throw_on_failure = false, a step_failure stop that keeps the points (a restart from
+// points.back().point() continues the curve).
 #include <Eigen/Core>
 
 #include <algorithm>
@@ -160,6 +172,56 @@ struct hopf_curve_result {
 };
 
 namespace internal {
+/// Throws input_error naming the offending option unless the options of a curve tracer are
+/// usable (both tracers): step sizes finite with 0 < min_step <= step <= ... and min_step <=
+/// max_step, growth >= 1, scales finite (mu, nu > 0, omega >= 0), bounds ordered, targets finite,
+/// the corrector's Newton options valid.
+inline void check_curve_options(const hopf_curve_options& o, const std::string& where) {
+  require(std::isfinite(o.step) && std::isfinite(o.min_step) && std::isfinite(o.max_step) && o.step > 0 &&
+              o.min_step > 0 && o.max_step >= o.min_step && o.step >= o.min_step,
+          where, ": bad step sizes (step ", o.step, ", min_step ", o.min_step, ", max_step ", o.max_step,
+          "): need finite 0 < min_step <= step, min_step <= max_step");
+  require(std::isfinite(o.mu_scale) && std::isfinite(o.nu_scale) && std::isfinite(o.omega_scale) && o.mu_scale > 0 &&
+              o.nu_scale > 0 && o.omega_scale >= 0,
+          where, ": metric scales must be finite, mu_scale and nu_scale > 0, omega_scale >= 0 (got ", o.mu_scale, ", ",
+          o.nu_scale, ", ", o.omega_scale, ")");
+  require(std::isfinite(o.growth) && o.growth >= 1, where, ": growth must be finite and >= 1 (got ", o.growth, ")");
+  require(o.fast_iterations >= 0, where, ": fast_iterations must be >= 0 (got ", o.fast_iterations, ")");
+  require(!std::isnan(o.nu_min) && !std::isnan(o.nu_max) && o.nu_min <= o.nu_max, where,
+          ": need nu_min <= nu_max (got ", o.nu_min, ", ", o.nu_max, ")");
+  require(!std::isnan(o.mu_min) && !std::isnan(o.mu_max) && o.mu_min <= o.mu_max, where,
+          ": need mu_min <= mu_max (got ", o.mu_min, ", ", o.mu_max, ")");
+  require(o.max_points >= 1, where, ": max_points must be >= 1 (got ", o.max_points, ")");
+  require_finite(o.nu_targets, where, "nu_targets");
+  require(std::isfinite(o.omega_min) && o.omega_min >= 0, where, ": omega_min must be finite and >= 0 (got ",
+          o.omega_min, ")");
+  require(o.corrector_distance > 0 && !std::isnan(o.corrector_distance), where,
+          ": corrector_distance must be > 0 (got ", o.corrector_distance, ")");
+  require(o.min_cosine >= -1 && o.min_cosine < 1, where, ": min_cosine must lie in [-1, 1) (got ", o.min_cosine, ")");
+  require(std::isfinite(o.nu_step) && o.nu_step >= 0, where, ": nu_step must be finite and >= 0 (got ", o.nu_step,
+          ")");
+  check_newton_options(o.newton, where, "newton");
+  check_hopf_options(o.start, where + " (start options)");
+}
+
+/// The equilibrium post-check of hopf.hpp for a converged corrector of a tracer: ||f(w, mu)|| =
+/// fn against tol_f. Empty if accepted, else the reason. (The frequency check is the caller's:
+/// omega below the resolved floor is the Bogdanov-Takens end, not a failed corrector.)
+inline std::string curve_equilibrium_check(double fn, double tol_f, double nu, double mu, double omega) {
+  if (!(fn <= tol_f))
+    return concat("the equilibrium does not hold at the corrected point (nu = ", nu, ", mu = ", mu, ", omega = ", omega,
+                  "): ||f(w, mu)|| = ", fn, " > tolerance ", tol_f);
+  return {};
+}
+
+/// What a tracer that stops on an aerohopf::error thrown outside its correctors says: the label,
+/// the number and coordinates of the last accepted point.
+inline std::string curve_failure_context(const std::string& label, std::size_t points, double nu, double mu,
+                                         double omega) {
+  return concat(label, ": stopped after point ", points == 0 ? 0 : points - 1, " (nu = ", nu, ", mu = ", mu,
+                ", omega = ", omega, "): ");
+}
+
 /// family(nu) for one nu at a time, reconstructed only when nu changes.
 template <class F, class S>
 class family_cache {
@@ -194,10 +256,7 @@ hopf_curve_result trace_hopf_curve(const F& family, double nu0, const hopf_point
   const std::string& lab = opt.label;
   const auto t_begin = clock::now();
   require(std::isfinite(nu0), lab, ": nu0 is not finite");
-  require(opt.step > 0 && opt.min_step > 0 && opt.max_step >= opt.min_step && opt.step >= opt.min_step,
-          lab, ": bad step sizes (step ", opt.step, ", min ", opt.min_step, ", max ", opt.max_step, ")");
-  require(opt.mu_scale > 0 && opt.nu_scale > 0 && opt.omega_scale >= 0, lab, ": metric scales must be positive");
-  require(opt.growth >= 1, lab, ": growth must be >= 1");
+  internal::check_curve_options(opt, lab);
   require(nu0 >= opt.nu_min && nu0 <= opt.nu_max, lab, ": nu0 = ", nu0, " outside [nu_min, nu_max]");
   require(direction == 1 || direction == -1, lab, ": direction must be +1 or -1");
   require(!opt.start.symmetric, lab, ": the symmetric Hopf system is not supported (w depends on nu)");
@@ -210,6 +269,13 @@ hopf_curve_result trace_hopf_curve(const F& family, double nu0, const hopf_point
   {
     const S sys0 = family(nu0);
     n = sys0.size();
+    require(n > 0, lab, ": family(nu0) has no unknowns");
+    require_size(start.w.size(), n, lab, "start.w (equilibrium at nu0)");
+    require_size(start.p.size(), n, lab, "start.p (eigenvector)");
+    require_finite(start.w, lab, "start.w (equilibrium at nu0)");
+    require_finite(start.p, lab, "start.p (eigenvector)");
+    require(std::isfinite(start.mu) && std::isfinite(start.omega), lab, ": start mu or omega is not finite (",
+            start.mu, ", ", start.omega, ")");
     hopf_options ho = opt.start;
     ho.label = lab + ": start point at nu = " + internal::concat(nu0);
     h0 = solve_hopf(sys0, start, ho);
@@ -318,28 +384,44 @@ hopf_curve_result trace_hopf_curve(const F& family, double nu0, const hopf_point
   struct corrected {
     vec<double> x;
     int iterations = 0;
+    double omega_floor = 0;  ///< the smallest |omega| its Newton run resolves (hopf.hpp)
   };
   std::string last_failure;
-  // Newton on G from x0 with the last row c.y = value; nullopt (and last_failure) on failure.
+  // Newton on G from x0 with the last row c.y = value; nullopt (and last_failure, with the last
+  // accepted iterate) on failure. A converged point passes the post-checks of hopf.hpp: f is the
+  // first block of G, so ||f(w, mu)|| <= the resolved ||G|| (confirmed, not assumed), and omega
+  // must exceed the resolved frequency 10 ||G|| / ||p|| or it is a real eigenvalue (the caller
+  // treats it as the Bogdanov-Takens end, omega -> 0).
   auto correct = [&](const vec<double>& x0, const vec<double>& s, const double* c,
                      double value) -> std::optional<corrected> {
     newton_options no = opt.newton;
     no.throw_on_failure = true;
+    internal::hopf_iterate_log last(x0, imu, iom, inu);
     try {
       newton_result nr = newton_iterate(
           [&](const vec<double>& x) { return residual(x, s, c, value); },
-          [&](const vec<double>& x, const vec<double>& f, int) {
+          [&](const vec<double>& x, const vec<double>& f, int k) {
+            last.record(x, f, k);
             lu.compute(jacobian(x, s, c));
             return vec<double>(-lu.solve(f));
           },
           x0, no, lab + " corrector");
       if (!nr.x.allFinite()) {
-        last_failure = "corrector returned a non-finite point";
+        last_failure = "corrector returned a non-finite point" + last.describe();
         return std::nullopt;
       }
-      return corrected{std::move(nr.x), nr.report.iterations};
+      const double r = internal::hopf_resolved_residual(nr.report, no);
+      const vec<double>& xc = nr.x;
+      const double fn = internal::hopf_norm(vec<double>(cur.at(xc[inu]).residual(vec<double>(xc.head(n)), xc[imu])));
+      const double floor = internal::hopf_frequency_floor(r, xc.segment(ipr, 2 * n).norm());
+      const std::string why = internal::curve_equilibrium_check(fn, r, xc[inu], xc[imu], xc[iom]);
+      if (!why.empty()) {
+        last_failure = why;
+        return std::nullopt;
+      }
+      return corrected{std::move(nr.x), nr.report.iterations, floor};
     } catch (const error& e) {
-      last_failure = e.what();
+      last_failure = e.what() + last.describe();
       return std::nullopt;
     }
   };
@@ -429,6 +511,10 @@ hopf_curve_result trace_hopf_curve(const F& family, double nu0, const hopf_point
   const vec<double> x_first = x;
   vec<double> x_prev;  // the point before x (for the Bogdanov-Takens extrapolation)
   double ds = std::min(opt.step, opt.max_step), arclength = 0;
+  // An aerohopf::error escaping the step (a normalisation that breaks down, a family that throws
+  // outside a corrector) ends the trace like a step failure: rethrown with the last point's
+  // context (same type), or with throw_on_failure = false a step_failure stop keeping the points.
+  try {
   for (;;) {
     const auto t_point = clock::now();
     int attempts = 0;
@@ -495,8 +581,9 @@ hopf_curve_result trace_hopf_curve(const F& family, double nu0, const hopf_point
     vec<double> xnew = std::move(xn->x);
     const int iters = xn->iterations;
 
-    // ---- Bogdanov-Takens: omega reaches zero or changes sign ----
-    if (xnew[iom] <= opt.omega_min) {
+    // ---- Bogdanov-Takens: omega reaches zero (or below what the corrector resolves) or changes sign ----
+    const double omega_floor = xn->omega_floor;
+    if (xnew[iom] <= std::max(opt.omega_min, omega_floor)) {
       // (mu, nu) are smooth in omega^2 along the curve: least squares of y = a + b omega^2
       std::vector<const vec<double>*> pts = {&x, &xnew};
       if (x_prev.size()) pts.push_back(&x_prev);
@@ -512,7 +599,7 @@ hopf_curve_result trace_hopf_curve(const F& family, double nu0, const hopf_point
         const double a = std::abs(det) > 1e-300 ? (szz * sy[j] - sz * szy[j]) / det : xnew[imu + j];
         (j == 0 ? res.bogdanov_takens_mu : res.bogdanov_takens_nu) = a;
       }
-      if (xnew[iom] > 0)
+      if (xnew[iom] > omega_floor)  // a Hopf point with a resolved frequency
         emit(make_point(xnew, iters, attempts, ydist(xnew, x), seconds_since(t_point), false));
       return finish(hopf_curve_stop::bogdanov_takens,
                     internal::concat("omega -> 0: the Hopf curve ends at a Bogdanov-Takens point near nu = ",
@@ -533,6 +620,11 @@ hopf_curve_result trace_hopf_curve(const F& family, double nu0, const hopf_point
       double c[3] = {0, 0, 0};
       c[l.row] = 1;
       auto xl = correct(x0, s, c, l.value);
+      if (xl && !(xl->x[iom] > xl->omega_floor)) {
+        last_failure = internal::concat("the landed point has omega = ", xl->x[iom], ", not above the resolved frequency ",
+                                        xl->omega_floor);
+        xl.reset();
+      }
       if (xl) {
         emit(make_point(xl->x, xl->iterations, 1, ydist(xl->x, x), seconds_since(t_land), true));
       } else {
@@ -568,6 +660,12 @@ hopf_curve_result trace_hopf_curve(const F& family, double nu0, const hopf_point
       return finish(hopf_curve_stop::closed_curve,
                     internal::concat("the curve closed on its start after arclength ", arclength));
     if (iters <= opt.fast_iterations) ds = std::min(opt.max_step, opt.growth * ds);
+  }
+  } catch (const error& e) {
+    const hopf_curve_point& lp = res.points.back();  // the start at least
+    const std::string where = internal::curve_failure_context(lab, res.points.size(), lp.nu, lp.mu, lp.omega);
+    if (opt.throw_on_failure) internal::rethrow_with_context(where, "");
+    return finish(hopf_curve_stop::step_failure, where + e.what());
   }
 }
 

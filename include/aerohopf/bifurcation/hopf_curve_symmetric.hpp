@@ -124,6 +124,11 @@
 // nu_targets, observer per accepted point, throw_on_failure = false. opt.start (hopf_options)
 // converges the start at nu0 with solve_hopf_krylov (symmetric forced). Per-point costs (GMRES
 // iterations, steady solves) are returned alongside in symmetric_hopf_curve_result::stats.
+// Post-checks and failure reports as hopf_curve.hpp, with the equilibrium check of the fixed
+// equilibrium: the w0(nu*) a converged corrector used must satisfy ||f(w0, mu*)|| <=
+// ||f(w0, mu_solved)|| + steady.abs_tolerance (it was solved at mu_solved; a family whose
+// equilibrium moves with mu fails this, and its start point is refused by solve_hopf_krylov,
+// whose equilibrium tolerance is what the start's steady solve reached + steady.abs_tolerance).
 #include <Eigen/Core>
 
 #include <algorithm>
@@ -242,10 +247,7 @@ symmetric_hopf_curve_result trace_symmetric_hopf_curve(const F& family, double n
   const std::string& lab = opt.label;
   const auto t_begin = clock::now();
   require(std::isfinite(nu0), lab, ": nu0 is not finite");
-  require(opt.step > 0 && opt.min_step > 0 && opt.max_step >= opt.min_step && opt.step >= opt.min_step,
-          lab, ": bad step sizes (step ", opt.step, ", min ", opt.min_step, ", max ", opt.max_step, ")");
-  require(opt.mu_scale > 0 && opt.nu_scale > 0 && opt.omega_scale >= 0, lab, ": metric scales must be positive");
-  require(opt.growth >= 1, lab, ": growth must be >= 1");
+  internal::check_curve_options(opt, lab);
   require(nu0 >= opt.nu_min && nu0 <= opt.nu_max, lab, ": nu0 = ", nu0, " outside [nu_min, nu_max]");
   require(direction == 1 || direction == -1, lab, ": direction must be +1 or -1");
   require(sopt.fill_level >= 0, lab, ": fill level ", sopt.fill_level, " < 0");
@@ -255,8 +257,18 @@ symmetric_hopf_curve_result trace_symmetric_hopf_curve(const F& family, double n
           ", dw0/dnu ", sopt.derivative_tolerance, ")");
   require(sopt.steady.abs_tolerance > 0 && sopt.steady.max_iterations >= 1, lab,
           ": nested steady Newton needs abs_tolerance > 0 and max_iterations >= 1");
-  require(std::isfinite(start.mu) && std::isfinite(start.omega), lab, ": start mu or omega is not finite");
+  internal::check_newton_options(sopt.steady, lab, "steady");
+  require(std::isfinite(sopt.steady.abs_tolerance), lab, ": steady.abs_tolerance is not finite");
+  require(sopt.krylov.relative_tolerance >= 0 && sopt.krylov.relative_tolerance < 1, lab,
+          ": krylov.relative_tolerance must lie in [0, 1) (got ", sopt.krylov.relative_tolerance, ")");
+  require(sopt.krylov.max_iterations >= 1 && sopt.krylov.restart >= 1, lab,
+          ": krylov.max_iterations and krylov.restart must be >= 1 (got ", sopt.krylov.max_iterations, ", ",
+          sopt.krylov.restart, ")");
+  require(std::isfinite(start.mu) && std::isfinite(start.omega), lab, ": start mu or omega is not finite (", start.mu,
+          ", ", start.omega, ")");
   require(sopt.iterate_distance > 0, lab, ": iterate_distance must be > 0 (got ", sopt.iterate_distance, ")");
+  require(std::isfinite(sopt.kink_distance) && sopt.kink_distance > 0, lab,
+          ": kink_distance must be finite and > 0 (got ", sopt.kink_distance, ")");
 
   symmetric_hopf_curve_result res;
   symmetric_hopf_curve_stats acc;  // costs since the last accepted point
@@ -267,8 +279,10 @@ symmetric_hopf_curve_result trace_symmetric_hopf_curve(const F& family, double n
     n = s0.size();
   }
   require(n > 0, lab, ": family(nu0) has no unknowns");
-  require(start.w.size() == n, lab, ": start state has ", start.w.size(), " entries, family(nu0) ", n);
-  require(start.p.size() == n, lab, ": start eigenvector has ", start.p.size(), " entries, family(nu0) ", n);
+  require_size(start.w.size(), n, lab, "start.w (equilibrium at nu0)");
+  require_size(start.p.size(), n, lab, "start.p (eigenvector)");
+  require_finite(start.w, lab, "start.w (equilibrium at nu0)");
+  require_finite(start.p, lab, "start.p (eigenvector)");
   const Eigen::Index padded = padded_block_count(n, B) * B;
   const Eigen::Index N = 2 * n + 3, ipr = 0, ipi = n, imu = 2 * n, inu = 2 * n + 1, iom = 2 * n + 2;
   const hopf_normalisation mode = resolve_normalisation<M>(opt.normalisation);
@@ -325,6 +339,7 @@ symmetric_hopf_curve_result trace_symmetric_hopf_curve(const F& family, double n
   struct equilibrium {
     double nu;
     vec<double> w, dw;  // w0(nu), dw0/dnu (empty until needed)
+    double mu;          // the mu it was solved at (the post-check compares f at mu* with f there)
   };
   std::vector<equilibrium> cache;
   block_ilu_options rio;
@@ -408,14 +423,15 @@ symmetric_hopf_curve_result trace_symmetric_hopf_curve(const F& family, double n
     return *best;
   };
   // Keeps w0(nu) (replacing an entry at the same nu; the oldest goes when the cache is full).
-  auto remember = [&](double nu, vec<double> w, vec<double> dw) -> equilibrium& {
+  auto remember = [&](double nu, vec<double> w, vec<double> dw, double mu) -> equilibrium& {
     if (equilibrium* e = find_equilibrium(nu)) {
       e->w = std::move(w);
       e->dw = std::move(dw);
+      e->mu = mu;
       return *e;
     }
     if (cache.size() >= std::max<std::size_t>(sopt.equilibrium_cache, 2)) cache.erase(cache.begin());
-    cache.push_back({nu, std::move(w), std::move(dw)});
+    cache.push_back({nu, std::move(w), std::move(dw), mu});
     return cache.back();
   };
   // w0(nu) (solved if not cached), warm-started from the nearest cached nu along its dw0/dnu.
@@ -441,7 +457,7 @@ symmetric_hopf_curve_result trace_symmetric_hopf_curve(const F& family, double n
     }
     if (w.size() == 0)
       throw convergence_error(internal::concat(lab, ": no steady state at nu = ", nu, " (", failures, ")"));
-    return remember(nu, std::move(w), vec<double>());
+    return remember(nu, std::move(w), vec<double>(), mu);
   };
 
   // ---- the Hopf residual and the bordered linear solves ----
@@ -519,8 +535,31 @@ symmetric_hopf_curve_result trace_symmetric_hopf_curve(const F& family, double n
   struct corrected {
     vec<double> x;
     int iterations = 0;
+    double omega_floor = 0;  ///< the smallest |omega| its Newton run resolves (hopf.hpp)
   };
   std::string last_failure;
+  // Post-checks of a converged corrector (hopf.hpp). The equilibrium w0(nu*) it used must hold
+  // at mu* as it did where it was solved: ||f(w0, mu*)|| <= ||f(w0, mu_solved)|| +
+  // steady.abs_tolerance (mu_solved = mu* for the joint corrector, whose residual holds f; for
+  // the nested one this catches an equilibrium that moves with mu, which the fixed-equilibrium
+  // Hopf system cannot follow). The frequency floor 10 ||G|| / ||p|| goes to the caller
+  // (below it: the Bogdanov-Takens end). nullopt and last_failure when refused.
+  auto post_check = [&](vec<double> x, const newton_report& rep, const newton_options& no) -> std::optional<corrected> {
+    const double r = internal::hopf_resolved_residual(rep, no);
+    const double mu = x[imu], nu = x[inu];
+    const equilibrium& e = equilibrium_at(nu, mu);  // cached: the corrector's last residual was at this nu
+    const S& sys = system_at(cur, nu);
+    const double fn = internal::hopf_norm(vec<double>(sys.residual(e.w, mu)));
+    const double f_solved = e.mu == mu ? fn : internal::hopf_norm(vec<double>(sys.residual(e.w, e.mu)));
+    const std::string why =
+        internal::curve_equilibrium_check(fn, f_solved + sopt.steady.abs_tolerance, nu, mu, x[iom]);
+    if (!why.empty()) {
+      last_failure = why;
+      return std::nullopt;
+    }
+    const double floor = internal::hopf_frequency_floor(r, x.segment(ipr, 2 * n).norm());
+    return corrected{std::move(x), rep.iterations, floor};
+  };
   // GMRES tolerance of a corrector iteration at residual norm fn (file comment)
   auto corrector_tolerance = [&](double fn) {
     return sopt.adaptive_tolerance ? forcing(fn, opt.newton.abs_tolerance)
@@ -542,6 +581,7 @@ symmetric_hopf_curve_result trace_symmetric_hopf_curve(const F& family, double n
     newton_options no = opt.newton;
     no.throw_on_failure = true;
     vec<double> dw_nu_last;
+    internal::hopf_iterate_log last(x0, imu, iom, inu);
     try {
       vec<double> X0(N + n);
       X0.head(N) = x0;
@@ -559,6 +599,7 @@ symmetric_hopf_curve_result trace_symmetric_hopf_curve(const F& family, double n
             return r;
           },
           [&](const vec<double>& X, const vec<double>& r, int it) {
+            last.record(X, r, it);
             const auto t0 = clock::now();
             const vec<double> x = X.head(N), w = X.tail(n);
             const double mu = x[imu], nu = x[inu];
@@ -599,15 +640,15 @@ symmetric_hopf_curve_result trace_symmetric_hopf_curve(const F& family, double n
           },
           std::move(X0), no, lab + " joint corrector");
       if (!nr.x.allFinite()) {
-        last_failure = "joint corrector returned a non-finite point";
+        last_failure = "joint corrector returned a non-finite point" + last.describe();
         return std::nullopt;
       }
       vec<double> x = nr.x.head(N);
       // dw0/dnu of the last step's iterate: it differs from the converged flow by that step only
-      remember(x[inu], nr.x.tail(n), std::move(dw_nu_last));
-      return corrected{std::move(x), nr.report.iterations};
+      remember(x[inu], nr.x.tail(n), std::move(dw_nu_last), x[imu]);
+      return post_check(std::move(x), nr.report, no);
     } catch (const error& e) {
-      last_failure = e.what();
+      last_failure = e.what() + last.describe();
       return std::nullopt;
     }
   };
@@ -619,6 +660,7 @@ symmetric_hopf_curve_result trace_symmetric_hopf_curve(const F& family, double n
     if (joint_now) return correct_joint(x0, s, c, value, radius);
     newton_options no = opt.newton;
     no.throw_on_failure = true;
+    internal::hopf_iterate_log last(x0, imu, iom, inu);
     try {
       newton_result nr = newton_iterate(
           [&](const vec<double>& x) {
@@ -626,17 +668,18 @@ symmetric_hopf_curve_result trace_symmetric_hopf_curve(const F& family, double n
             return residual(x, s, c, value);
           },
           [&](const vec<double>& x, const vec<double>& f, int it) {
+            last.record(x, f, it);
             return vec<double>(solve_bordered(x, s, c, vec<double>(-f), corrector_tolerance(f.norm()),
                                               internal::concat(lab, ": GMRES at corrector iteration ", it)));
           },
           x0, no, lab + " corrector");
       if (!nr.x.allFinite()) {
-        last_failure = "corrector returned a non-finite point";
+        last_failure = "corrector returned a non-finite point" + last.describe();
         return std::nullopt;
       }
-      return corrected{std::move(nr.x), nr.report.iterations};
+      return post_check(std::move(nr.x), nr.report, no);
     } catch (const error& e) {
-      last_failure = e.what();
+      last_failure = e.what() + last.describe();
       return std::nullopt;
     }
   };
@@ -690,12 +733,16 @@ symmetric_hopf_curve_result trace_symmetric_hopf_curve(const F& family, double n
   {
     check_state(system_at(cur, nu0), start.w, start.mu, "trace_symmetric_hopf_curve");
     vec<double> w0 = steady_solve(nu0, start.mu, start.w);
-    cache.push_back({nu0, w0, vec<double>()});
+    cache.push_back({nu0, w0, vec<double>(), start.mu});
     hopf_point g = start;
     g.w = std::move(w0);
     hopf_options ho = opt.start;
     ho.symmetric = true;
     ho.normalisation = opt.normalisation;
+    // the equilibrium holds to what the nested steady solve reached (post-checks, hopf.hpp)
+    ho.equilibrium_tolerance = std::max(
+        ho.equilibrium_tolerance,
+        internal::hopf_norm(vec<double>(system_at(cur, nu0).residual(g.w, start.mu))) + sopt.steady.abs_tolerance);
     ho.label = lab + ": start point at nu = " + internal::concat(nu0);
     hopf_krylov_options ko;
     ko.fill_level = sopt.fill_level;
@@ -769,6 +816,11 @@ symmetric_hopf_curve_result trace_symmetric_hopf_curve(const F& family, double n
   const vec<double> x_first = x;
   vec<double> x_prev;
   double ds = std::min(opt.step, opt.max_step), arclength = 0;
+  // An aerohopf::error escaping the step (a steady solve for a point's equilibrium, a
+  // normalisation that breaks down) ends the trace like a step failure: rethrown with the last
+  // point's context (same type), or with throw_on_failure = false a step_failure stop keeping
+  // the points.
+  try {
   for (;;) {
     const auto t_point = clock::now();
     int attempts = 0;
@@ -893,8 +945,9 @@ symmetric_hopf_curve_result trace_symmetric_hopf_curve(const F& family, double n
       acc.steady_seconds += step_costs.steady_seconds;
     };
 
-    // ---- Bogdanov-Takens: omega reaches zero ----
-    if (xnew[iom] <= opt.omega_min) {
+    // ---- Bogdanov-Takens: omega reaches zero (or below what the corrector resolves) ----
+    const double omega_floor = xn->omega_floor;
+    if (xnew[iom] <= std::max(opt.omega_min, omega_floor)) {
       std::vector<const vec<double>*> pts = {&x, &xnew};
       if (x_prev.size()) pts.push_back(&x_prev);
       double s1 = 0, sz = 0, szz = 0;
@@ -910,7 +963,8 @@ symmetric_hopf_curve_result trace_symmetric_hopf_curve(const F& family, double n
         (j == 0 ? res.bogdanov_takens_mu : res.bogdanov_takens_nu) = a;
       }
       add_step_costs();
-      if (xnew[iom] > 0) emit(make_point(xnew, iters, attempts, ydist(xnew, x), step_seconds, false));
+      if (xnew[iom] > omega_floor)  // a Hopf point with a resolved frequency
+        emit(make_point(xnew, iters, attempts, ydist(xnew, x), step_seconds, false));
       return finish(hopf_curve_stop::bogdanov_takens,
                     internal::concat("omega -> 0: the Hopf curve ends at a Bogdanov-Takens point near nu = ",
                                      res.bogdanov_takens_nu, ", mu = ", res.bogdanov_takens_mu, " (last omega ",
@@ -934,6 +988,11 @@ symmetric_hopf_curve_result trace_symmetric_hopf_curve(const F& family, double n
       if (!xl && joint_now) {
         joint_now = false;
         xl = correct(x0, s, c, l.value, sopt.iterate_distance * ds);
+      }
+      if (xl && !(xl->x[iom] > xl->omega_floor)) {
+        last_failure = internal::concat("the landed point has omega = ", xl->x[iom], ", not above the resolved frequency ",
+                                        xl->omega_floor);
+        xl.reset();
       }
       if (xl) {
         emit(make_point(xl->x, xl->iterations, 1, ydist(xl->x, x), seconds_since(t_land), true));
@@ -973,6 +1032,12 @@ symmetric_hopf_curve_result trace_symmetric_hopf_curve(const F& family, double n
       return finish(hopf_curve_stop::closed_curve,
                     internal::concat("the curve closed on its start after arclength ", arclength));
     if (iters <= opt.fast_iterations) ds = std::min(opt.max_step, opt.growth * ds);
+  }
+  } catch (const error& e) {
+    const hopf_curve_point& lp = res.points.back();  // the start at least
+    const std::string where = internal::curve_failure_context(lab, res.points.size(), lp.nu, lp.mu, lp.omega);
+    if (opt.throw_on_failure) internal::rethrow_with_context(where, "");
+    return finish(hopf_curve_stop::step_failure, where + e.what());
   }
 }
 
