@@ -430,21 +430,3 @@ TEST(euler_residual, raw_pointer_residual_checks_the_physical_state) {
   w[4 * 5] = -1.0;
   EXPECT_THROW(m.residual<double>(m.metrics(), w.data(), r.data()), input_error);
 }
-
-// With euler_options::check_state = false the check is skipped (the caller vouches for w):
-// a physical state gives bit-identical residuals either way.
-TEST(euler_residual, state_check_can_be_switched_off_without_changing_the_residual) {
-  const auto g = coarsen(naca_cgrid(), 8);
-  euler_model<2> checked(g, {.mach = 0.8, .alpha_rad = 0.02});
-  euler_options o;
-  o.check_state = false;
-  euler_model<2> unchecked(g, {.mach = 0.8, .alpha_rad = 0.02}, o);
-  vec<double> w = checked.free_stream_vector();
-  for (Eigen::Index k = 0; k < w.size(); ++k) w[k] *= 1.0 + 0.01 * std::cos(0.21 * double(k));
-  EXPECT_EQ((checked.residual(w) - unchecked.residual(w)).cwiseAbs().maxCoeff(), 0.0);
-  w[8] = -w[8];
-  EXPECT_THROW((void)checked.residual(w), input_error);
-  EXPECT_NO_THROW((void)unchecked.residual(w));
-  // the size is checked regardless
-  EXPECT_THROW((void)unchecked.residual(vec<double>(w.head(8))), input_error);
-}

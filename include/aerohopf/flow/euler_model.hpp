@@ -87,13 +87,6 @@ struct euler_options {
   /// a PARAMETER of the residual (the Jacobians do not differentiate it); solve_steady updates
   /// it to CL/2 every step, so at convergence it is consistent.
   bool vortex_far_field = false;
-  /// Refuse (input_error naming block, cell, density and pressure) a state with a cell whose
-  /// density or pressure is not positive and finite, at every entry point that takes a state
-  /// (residuals, Jacobians, spectral radius, forces). Such a state has a NaN sound speed that
-  /// turns every wave-sign test of the Osher flux false: finite garbage, no error. Judged on
-  /// the value part of the scalar (to_double). One pass over the state; set false only where
-  /// the caller has already vouched for every state it passes (sizes are checked regardless).
-  bool check_state = true;
 };
 
 /// Force and moment coefficients (reference length 1, reference area 1 (2D: per unit span),
@@ -201,6 +194,13 @@ class euler_model {
     return v;
   }
 
+  /// Every entry point that takes a state (residuals, Jacobians, spectral radius, forces)
+  /// checks its size (require_size; Eigen's assertions are off in Release builds) and refuses
+  /// a cell whose density or pressure is not positive and finite (require_physical): such a
+  /// state has a NaN sound speed that turns every wave-sign test of the Osher flux false, which
+  /// gives finite garbage and no error. The physical check is one pass over the state, under 1%
+  /// of a residual evaluation (double or taylor<>), so it is never skipped.
+  ///
   /// An interior cell whose density or pressure is not positive and finite.
   struct state_defect {
     int block;
@@ -248,8 +248,7 @@ class euler_model {
                                                  ": not a physical state (both must be positive and finite)"));
   }
 
-  /// R(w) with the model's own (double) metrics. Checks the size and (options().check_state)
-  /// the physical state of w.
+  /// R(w) with the model's own (double) metrics. Checks the size and the physical state of w.
   template <class S>
   vec<S> residual(const vec<S>& w) const {
     require_size(w.size(), size(), "euler_model::residual", "state");
@@ -263,7 +262,7 @@ class euler_model {
   }
 
   /// R(w) with given metrics (e.g. of a grid moved by a taylor<> structural state). Checks the
-  /// metrics' shapes, the size and (options().check_state) the physical state of w.
+  /// metrics' shapes, the size and the physical state of w.
   template <class S>
   vec<S> residual(const grid_metrics<S, Dim>& m, const vec<S>& w) const {
     require_size(w.size(), size(), "euler_model::residual", "state");
@@ -273,12 +272,12 @@ class euler_model {
   }
 
   /// Internal form: w and r point to at least size() values each (NOT checked; a coupled
-  /// system passes the flow part of its longer state this way). The metrics and (with
-  /// options().check_state) the physical state of the size() values read are checked.
+  /// system passes the flow part of its longer state this way). The metrics and the physical
+  /// state of the size() values read are checked.
   template <class S>
   void residual(const grid_metrics<S, Dim>& m, const S* w, S* r) const {
     check_metrics(m);
-    if (opt_.check_state) require_physical<S>(w, "euler_model::residual");
+    require_physical<S>(w, "euler_model::residual");
     std::vector<std::vector<state<S, Dim>>> padded;
     fill_padded<S>(m, w, padded);
     std::vector<std::vector<primitive<S, Dim>>> prim(padded.size());
@@ -623,10 +622,10 @@ class euler_model {
     }
   }
 
-  /// Size and (options().check_state) physical state of a double state vector.
+  /// Size and physical state of a double state vector.
   void check_state_vector(const vec<double>& w, std::string_view where) const {
     require_size(w.size(), size(), where, "state");
-    if (opt_.check_state) require_physical<double>(w.data(), where);
+    require_physical<double>(w.data(), where);
   }
 
   void build_layout() {

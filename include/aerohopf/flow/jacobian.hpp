@@ -96,8 +96,8 @@ std::vector<std::pair<Eigen::Index, Eigen::Index>> jacobian_pattern(const euler_
 }
 
 /// Assembles dR/dw (R = dw/dt) at state w into a (pattern set here if a is empty or has the
-/// wrong size, otherwise reused with set_zero()). The size and (m.options().check_state) the
-/// physical state of w are checked before a is touched.
+/// wrong size, otherwise reused with set_zero()). The size and the physical state of w are
+/// checked before a is touched.
 template <int Dim>
 void assemble_jacobian(const euler_model<Dim>& m, const vec<double>& w, jacobian_kind kind,
                        block_sparse_matrix<double, Dim + 2>& a) {
@@ -105,7 +105,7 @@ void assemble_jacobian(const euler_model<Dim>& m, const vec<double>& w, jacobian
   using jet = taylor<double, 1>;
   using block = Eigen::Matrix<double, nv, nv>;
   require_size(w.size(), m.size(), "assemble_jacobian", "state");
-  if (m.options().check_state) m.template require_physical<double>(w.data(), "assemble_jacobian");
+  m.template require_physical<double>(w.data(), "assemble_jacobian");
   const auto ncell = static_cast<Eigen::Index>(m.n_cells());
   if (a.block_rows() != ncell) a.set_pattern(ncell, ncell, jacobian_pattern<Dim>(m, kind));
   a.set_zero(false);
