@@ -10,6 +10,8 @@
 
 #include <cmath>
 #include <random>
+#include <string>
+#include <vector>
 
 using namespace aerohopf;
 using namespace aerohopf::flow;
@@ -164,4 +166,78 @@ TEST(jacobian, exact_product_matches_jet_derivative_3d) {
   assemble_jacobian<3>(m, w, jacobian_kind::modified_order, b);
   const auto nb = blocks_per_row<3>(b);
   EXPECT_EQ(*std::max_element(nb.begin(), nb.end()), 7);
+}
+
+// ---- hostile input ---------------------------------------------------------------------------
+
+namespace {
+
+/// Unit-spaced 3D box, far field all round.
+euler_model<3> box_model_3d(index_d<3> cells) {
+  multiblock_grid<3> g;
+  grid_block<double, 3> b;
+  for (int d = 0; d < 3; ++d) b.points[d] = cells[d] + 1;
+  b.x.resize(b.n_points());
+  for (std::size_t k = 0; k < b.x.size(); ++k) {
+    const auto i = unravel<3>(k, b.points);
+    for (int d = 0; d < 3; ++d) b.x[k][d] = 0.25 * i[d] + 0.01 * i[(d + 1) % 3];
+  }
+  g.points.blocks.push_back(b);
+  g.topology.cells = {cells};
+  for (int f = 0; f < 6; ++f) g.topology.patches.push_back(whole_face<3>(0, f, cells, boundary_kind::far_field));
+  return euler_model<3>(g, {.mach = 0.7, .alpha_rad = 0.05});
+}
+
+template <class Fn>
+std::string input_error_of(Fn&& fn) {
+  try {
+    fn();
+  } catch (const input_error& e) {
+    return e.what();
+  }
+  ADD_FAILURE() << "no input_error thrown";
+  return "";
+}
+
+bool contains(const std::string& s, const std::string& part) { return s.find(part) != std::string::npos; }
+
+}  // namespace
+
+// A state of the wrong size or with a non-physical cell is refused by both Jacobians (the
+// old code assembled finite garbage from NaN sound speeds), and the matrix passed in is left
+// untouched by the refusal.
+TEST(jacobian, wrong_size_and_non_physical_states_are_refused) {
+  std::mt19937 rng(31);
+  const auto m = moving_cgrid_model(2);
+  const vec<double> w = perturbed_state<2>(m, rng, 0.02);
+  for (auto kind : {jacobian_kind::exact, jacobian_kind::modified_order}) {
+    block_sparse_matrix<double, 4> a;
+    assemble_jacobian<2>(m, w, kind, a);
+    const std::vector<double> before = a.values();
+    EXPECT_TRUE(contains(input_error_of([&] { assemble_jacobian<2>(m, vec<double>(w.head(w.size() - 4)), kind, a); }),
+                         "expected " + std::to_string(m.size())));
+    const int b = 2;
+    const index_d<2> ij{1, 4};
+    const auto c = static_cast<Eigen::Index>(m.cell_offset(b) + linear_index<2>(ij, m.grid().topology.cells[b]));
+    vec<double> bad = w;
+    bad[4 * c + 3] = 0.0;  // zero energy: negative pressure
+    const std::string msg = input_error_of([&] { assemble_jacobian<2>(m, bad, kind, a); });
+    for (const char* part : {"block 2", "cell (1,4)", "density", "pressure"}) EXPECT_TRUE(contains(msg, part)) << msg;
+    EXPECT_TRUE(a.values() == before);
+  }
+}
+
+// 3D: the cell is named by its three indices, in the residual and the Jacobian alike.
+TEST(jacobian, non_physical_state_in_3d_names_the_three_cell_indices) {
+  const auto m = box_model_3d({3, 4, 2});
+  vec<double> w = m.free_stream_vector();
+  const auto c = static_cast<Eigen::Index>(linear_index<3>({2, 1, 1}, {3, 4, 2}));
+  w[5 * c] = -0.5;
+  block_sparse_matrix<double, 5> a;
+  for (const std::string& msg : {input_error_of([&] { (void)m.residual(w); }),
+                                 input_error_of([&] { assemble_jacobian<3>(m, w, jacobian_kind::exact, a); })}) {
+    EXPECT_TRUE(contains(msg, "block 0")) << msg;
+    EXPECT_TRUE(contains(msg, "cell (2,1,1)")) << msg;
+    EXPECT_TRUE(contains(msg, "density -0.5")) << msg;
+  }
 }

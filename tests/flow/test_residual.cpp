@@ -9,7 +9,9 @@
 #include <aerohopf/scalar.hpp>
 
 #include <cmath>
+#include <limits>
 #include <random>
+#include <string>
 
 using namespace aerohopf;
 using namespace aerohopf::flow;
@@ -275,4 +277,156 @@ TEST(euler_residual, jet_grid_motion_matches_finite_differences) {
   const auto rq = m.residual(wq);
   const auto r = m.residual(w);
   for (Eigen::Index k = 0; k < w.size(); ++k) EXPECT_NEAR(to_double(rq[k]), r[k], 1e-12 * r.cwiseAbs().maxCoeff());
+}
+
+// ---- hostile input: every public entry point that takes a state checks it -----------------
+
+namespace {
+
+euler_model<2> small_cgrid_model() { return euler_model<2>(coarsen(naca_cgrid(), 8), {.mach = 0.8, .alpha_rad = 0.02}); }
+
+template <class T>
+vec<T> converted(const vec<double>& w) {
+  vec<T> r(w.size());
+  for (Eigen::Index k = 0; k < w.size(); ++k) r[k] = T(w[k]);
+  return r;
+}
+
+/// what() of the input_error that fn throws ("" and a test failure if it throws none).
+template <class Fn>
+std::string input_error_of(Fn&& fn) {
+  try {
+    fn();
+  } catch (const input_error& e) {
+    return e.what();
+  }
+  ADD_FAILURE() << "no input_error thrown";
+  return "";
+}
+
+bool contains(const std::string& s, const std::string& part) { return s.find(part) != std::string::npos; }
+
+}  // namespace
+
+// One cell short (the old code read past the end of w), one cell long (silently ignored) and
+// empty (null data): refused by every overload and entry point, in every scalar, with a
+// message giving both sizes.
+TEST(euler_residual, wrong_size_state_is_refused_by_every_entry_point) {
+  const auto m = small_cgrid_model();
+  const vec<double> w = m.free_stream_vector();
+  const vec<double> shorter = w.head(w.size() - 4);
+  vec<double> longer(w.size() + 4);
+  longer << w, w.head(4);
+  const vec<double> empty;
+  const std::string expected = "expected " + std::to_string(m.size());
+  for (const vec<double>* bad : std::initializer_list<const vec<double>*>{&shorter, &longer, &empty}) {
+    SCOPED_TRACE(bad->size());
+    EXPECT_TRUE(contains(input_error_of([&] { (void)m.residual(*bad); }), expected));
+    EXPECT_TRUE(contains(input_error_of([&] { (void)m.residual(m.metrics(), *bad); }), expected));
+    EXPECT_TRUE(contains(input_error_of([&] { (void)m.residual(converted<dd_real>(*bad)); }), expected));
+    EXPECT_TRUE(contains(input_error_of([&] { (void)m.residual(converted<qd_real>(*bad)); }), expected));
+    EXPECT_TRUE(contains(input_error_of([&] { (void)m.residual(converted<taylor<double, 1>>(*bad)); }), expected));
+    EXPECT_TRUE(contains(input_error_of([&] { (void)m.spectral_radius(*bad); }), expected));
+    EXPECT_TRUE(contains(input_error_of([&] { (void)m.forces(*bad); }), expected));
+    EXPECT_TRUE(contains(input_error_of([&] { (void)m.wall_faces(*bad); }), expected));
+    EXPECT_TRUE(contains(input_error_of([&] { (void)m.is_physical(*bad); }), expected));
+  }
+}
+
+// Metrics whose arrays do not match their own cell counts (hand-made or truncated) are refused
+// before the residual indexes them.
+TEST(euler_residual, inconsistent_metrics_are_refused) {
+  const auto m = small_cgrid_model();
+  const vec<double> w = m.free_stream_vector();
+  auto bad = m.metrics();
+  bad.blocks[1].volume.pop_back();
+  EXPECT_TRUE(contains(input_error_of([&] { (void)m.residual(bad, w); }), "block 1"));
+  bad = m.metrics();
+  bad.blocks[2].normal[1].pop_back();
+  EXPECT_TRUE(contains(input_error_of([&] { (void)m.residual(bad, w); }), "block 2"));
+  bad = m.metrics();
+  bad.blocks[0].speed[0].clear();
+  EXPECT_TRUE(contains(input_error_of([&] { (void)m.residual(bad, w); }), "block 0"));
+}
+
+// Fewer blocks than the model (the old code read the metrics past their end), a block of
+// another shape, velocities of another block count or shape: refused, and the model is left
+// exactly as it was.
+TEST(euler_residual, set_grid_motion_refuses_mismatched_grids_and_keeps_the_model) {
+  auto m = small_cgrid_model();
+  vec<double> w = m.free_stream_vector();
+  for (Eigen::Index k = 0; k < w.size(); ++k) w[k] *= 1.0 + 0.01 * std::sin(0.37 * double(k));
+  const vec<double> r0 = m.residual(w);
+  const auto full = m.grid().points;
+
+  auto fewer = full;
+  fewer.blocks.pop_back();
+  EXPECT_TRUE(contains(input_error_of([&] { m.set_grid_motion(fewer, nullptr); }), "blocks"));
+  EXPECT_TRUE(contains(input_error_of([&] { m.set_grid_motion(fewer, &fewer); }), "blocks"));
+  EXPECT_TRUE(contains(input_error_of([&] { m.set_grid_motion(full, &fewer); }), "blocks"));
+
+  auto reshaped = full;  // block 0 one point row shorter, still a valid grid block
+  auto& b0 = reshaped.blocks[0];
+  b0.points[1] -= 1;
+  b0.x.resize(b0.n_points());
+  EXPECT_THROW(m.set_grid_motion(reshaped, nullptr), input_error);
+  EXPECT_THROW(m.set_grid_motion(full, &reshaped), input_error);
+
+  EXPECT_EQ(m.grid().points.blocks.size(), full.blocks.size());
+  const vec<double> r1 = m.residual(w);
+  EXPECT_EQ((r1 - r0).cwiseAbs().maxCoeff(), 0.0);
+}
+
+// Negative density, negative pressure, NaN and Inf in one cell: refused by the residual in
+// every scalar (judged on the value part), by the spectral radius and the forces, with the
+// block, the cell (i,j), the density and the pressure in the message. A physical state passes.
+TEST(euler_residual, non_physical_state_is_refused_naming_block_and_cell) {
+  const auto m = small_cgrid_model();
+  const vec<double> w0 = m.free_stream_vector();
+  EXPECT_TRUE(m.is_physical(w0));
+  const int b = 1;
+  const index_d<2> ij{3, 2};
+  const auto c = static_cast<Eigen::Index>(m.cell_offset(b) + linear_index<2>(ij, m.grid().topology.cells[b]));
+  const double nan = std::numeric_limits<double>::quiet_NaN(), inf = std::numeric_limits<double>::infinity();
+  struct defect {
+    const char* name;
+    int var;
+    double value;
+  };
+  const double kinetic = 0.5 * (w0[4 * c + 1] * w0[4 * c + 1] + w0[4 * c + 2] * w0[4 * c + 2]) / w0[4 * c];
+  for (const defect& d : {defect{"negative density", 0, -w0[4 * c]}, defect{"negative pressure", 3, 0.5 * kinetic},
+                          defect{"NaN momentum", 1, nan}, defect{"NaN density", 0, nan},
+                          defect{"infinite energy", 3, inf}}) {
+    SCOPED_TRACE(d.name);
+    vec<double> w = w0;
+    w[4 * c + d.var] = d.value;
+    EXPECT_FALSE(m.is_physical(w));
+    for (const std::string& msg :
+         {input_error_of([&] { (void)m.residual(w); }), input_error_of([&] { (void)m.residual(m.metrics(), w); }),
+          input_error_of([&] { (void)m.residual(converted<dd_real>(w)); }),
+          input_error_of([&] { (void)m.residual(converted<qd_real>(w)); }),
+          input_error_of([&] { (void)m.residual(converted<taylor<double, 2>>(w)); }),
+          input_error_of([&] { (void)m.spectral_radius(w); }), input_error_of([&] { (void)m.forces(w); })}) {
+      EXPECT_TRUE(contains(msg, "block 1")) << msg;
+      EXPECT_TRUE(contains(msg, "cell (3,2)")) << msg;
+      EXPECT_TRUE(contains(msg, "density")) << msg;
+      EXPECT_TRUE(contains(msg, "pressure")) << msg;
+    }
+  }
+  // a taylor<> state whose derivative part is anything: only the value part is judged
+  using jet = taylor<double, 1>;
+  vec<jet> wj(w0.size());
+  for (Eigen::Index k = 0; k < w0.size(); ++k) wj[k] = jet::variable(w0[k], k % 4 == 0 ? -1e3 : 0.0);
+  EXPECT_NO_THROW((void)m.residual(wj));
+}
+
+// The raw-pointer residual (internal: the coupled aerofoil system passes its longer state) cannot
+// check the size but still checks the physical state of the cells it reads.
+TEST(euler_residual, raw_pointer_residual_checks_the_physical_state) {
+  const auto m = small_cgrid_model();
+  vec<double> w = m.free_stream_vector();
+  vec<double> r(m.size());
+  EXPECT_NO_THROW(m.residual<double>(m.metrics(), w.data(), r.data()));
+  w[4 * 5] = -1.0;
+  EXPECT_THROW(m.residual<double>(m.metrics(), w.data(), r.data()), input_error);
 }

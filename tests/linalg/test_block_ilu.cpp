@@ -7,6 +7,8 @@
 #include <aerohopf/linalg/block_ilu.hpp>
 
 #include <algorithm>
+#include <functional>
+#include <limits>
 #include <numeric>
 #include <random>
 #include <set>
@@ -245,4 +247,46 @@ TEST(BlockIlu, ErrorsNameTheBlock) {
   o.fill_level = -1;
   using ilu2 = block_ilu<double, 2>;
   EXPECT_THROW(ilu2{o}, input_error);
+}
+
+// A failed factorisation (singular pivot, non-finite block, pattern other than the analysed
+// one) leaves the preconditioner refusing apply() with singular_matrix_error naming the
+// context, never applying stale factors of an earlier matrix (the old code applied them after
+// a refused factorize()); a later successful factorisation makes it usable again.
+TEST(BlockIlu, FailedFactorisationLeavesNoUsableFactors) {
+  const int n = 6;
+  pattern_t p;
+  for (int i = 0; i + 1 < n; ++i) p.emplace_back(i, i + 1);
+  const auto good = random_on_pattern<double, 2>(n, p, 2, 1);
+  auto singular = good;
+  singular.block(2, 2).setZero();
+  auto non_finite = good;
+  non_finite.block(4, 5)(1, 0) = std::numeric_limits<double>::infinity();
+  const auto other_pattern = random_on_pattern<double, 2>(n, {}, 2, 1);
+  block_ilu_options o;
+  o.context = "test BILU";
+  block_ilu<double, 2> m(o);
+  const vec<double> r = vec<double>::Ones(2 * n);
+  vec<double> z(2 * n), z_good(2 * n);
+  m.compute(good);
+  m.apply(r, z_good);
+  auto attempt_singular = [&] { m.factorize(singular); };
+  auto attempt_non_finite = [&] { m.factorize(non_finite); };
+  auto attempt_other = [&] { m.factorize(other_pattern); };
+  for (const std::function<void()>& attempt :
+       std::vector<std::function<void()>>{attempt_singular, attempt_non_finite, attempt_other}) {
+    EXPECT_THROW(attempt(), error);
+    try {
+      m.apply(r, z);
+      ADD_FAILURE() << "apply after a failed factorisation did not throw";
+    } catch (const singular_matrix_error& e) {
+      EXPECT_NE(std::string(e.what()).find("test BILU"), std::string::npos) << e.what();
+    }
+    m.factorize(good);
+    m.apply(r, z);
+    EXPECT_EQ((z - z_good).norm(), 0.0);
+  }
+  // apply before any factorisation: an input error (nothing failed, the call is premature)
+  block_ilu<double, 2> fresh;
+  EXPECT_THROW(fresh.apply(r, z), input_error);
 }

@@ -232,3 +232,34 @@ TEST(BlockSparseMatrix, DoubleDoubleCompilesAndMultiplies) {
   EXPECT_EQ(to_double(y(0) - dd_real(1.0)), 1e-20);  // not representable in double as 1 + 1e-20
   EXPECT_EQ(to_double(y(5)), 3.0);
 }
+
+// Products with vectors of the wrong size throw for every product of the matrix, of the
+// bordered operator and of the bordered preconditioner (whose apply() the old code ran on
+// any sizes, reading past r).
+TEST(BlockSparseMatrix, ProductsWithWrongSizeVectorsThrow) {
+  const Eigen::Index nb = 5, bs = 4, n = nb * bs, k = 2;
+  const auto t = random_triplets<double, 4>(nb, bs, 3, 12);
+  const auto a = block_sparse_matrix<double, 4>::from_triplets(nb, nb, t);
+  const vec<double> x = vec<double>::Random(n), shorter = vec<double>::Random(n - 1);
+  vec<double> y(n), y_short(n - 1);
+  EXPECT_THROW(a.apply(shorter, y), input_error);
+  EXPECT_THROW(a.apply(x, y_short), input_error);
+  EXPECT_THROW(a.multiply_add(1.0, shorter, y), input_error);
+  EXPECT_THROW(a.multiply_transpose(x, y_short), input_error);
+  vec<cd> xc = vec<cd>::Random(n - 1), yc(n);
+  EXPECT_THROW(a.apply_shifted(cd(0, 1), xc, yc), input_error);
+
+  const Eigen::MatrixXd u = Eigen::MatrixXd::Random(n, k), vt = Eigen::MatrixXd::Random(k, n),
+                        corner = Eigen::MatrixXd::Random(k, k) + 5.0 * Eigen::MatrixXd::Identity(k, k);
+  bordered_operator<block_sparse_matrix<double, 4>, double> op(a, n, u, vt, corner);
+  vec<double> yb(n + k);
+  EXPECT_THROW(op.apply(x, yb), input_error);
+  const Eigen::MatrixXd ainv = dense_of(t, nb, bs).inverse();
+  bordered_preconditioner<Eigen::MatrixXd, double> pre(op, ainv);
+  const vec<double> rb = vec<double>::Random(n + k);
+  vec<double> zb(n + k), z_short(n);
+  EXPECT_NO_THROW(pre.apply(rb, zb));
+  EXPECT_EQ(pre.rows(), n + k);
+  EXPECT_THROW(pre.apply(x, zb), input_error);
+  EXPECT_THROW(pre.apply(rb, z_short), input_error);
+}

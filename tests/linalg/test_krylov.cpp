@@ -8,7 +8,9 @@
 
 #include <aerohopf/linalg.hpp>
 
+#include <limits>
 #include <random>
+#include <string>
 
 using namespace aerohopf;
 using cd = std::complex<double>;
@@ -363,5 +365,152 @@ TEST(Krylov, FailuresAreReported) {
     EXPECT_FALSE(rep.converged) << rep.method;
     vec<double> wrong(7);
     EXPECT_THROW(run(method, a, identity_preconditioner{}, b, wrong, o), input_error);
+  }
+}
+
+// ---- hostile input: sizes, options and initial guesses are checked at the entry ---------------
+
+namespace {
+
+template <class Fn>
+std::string input_error_of(Fn&& fn) {
+  try {
+    fn();
+  } catch (const input_error& e) {
+    return e.what();
+  }
+  ADD_FAILURE() << "no input_error thrown";
+  return "";
+}
+
+bool contains(const std::string& s, const std::string& part) { return s.find(part) != std::string::npos; }
+
+}  // namespace
+
+// A dense operator smaller (or larger, or non-square) than the right-hand side: the old GMRES
+// reported convergence with relative residual 0 after reading and writing past the matrix.
+// Every method refuses it, naming the operator's size, before touching x.
+TEST(Krylov, OperatorOfTheWrongSizeIsRefused) {
+  const Eigen::Index n = 12;
+  const vec<double> b = vec<double>::Random(n);
+  const Eigen::MatrixXd smaller = Eigen::MatrixXd::Identity(n - 2, n - 2) * 2.0;
+  const Eigen::MatrixXd larger = Eigen::MatrixXd::Identity(n + 3, n + 3);
+  const Eigen::MatrixXd tall = Eigen::MatrixXd::Identity(n, n - 1);
+  const auto blocks = convection_diffusion<double, 4>(2, 2, 4, 1.0, 1.0, 5);  // 16 rows
+  for (auto method : all_methods) {
+    krylov_options o;
+    vec<double> x = vec<double>::Constant(n, 0.5);
+    EXPECT_TRUE(contains(input_error_of([&] { run(method, smaller, identity_preconditioner{}, b, x, o); }), "10"));
+    EXPECT_TRUE(contains(input_error_of([&] { run(method, larger, identity_preconditioner{}, b, x, o); }), "15"));
+    EXPECT_THROW(run(method, tall, identity_preconditioner{}, b, x, o), input_error);
+    EXPECT_TRUE(contains(input_error_of([&] { run(method, blocks, identity_preconditioner{}, b, x, o); }), "16"));
+    EXPECT_TRUE((x.array() == 0.5).all()) << "x modified by a refused call";
+  }
+}
+
+// A preconditioner of the wrong size (dense matrix, BILU of another matrix, bordered
+// preconditioner of another border), and a matrix-free operator or preconditioner that returns a
+// vector of the wrong size: refused, never read past the end.
+TEST(Krylov, PreconditionerAndMatrixFreeResultsOfTheWrongSizeAreRefused) {
+  const auto a = convection_diffusion<double, 4>(3, 3, 4, 1.0, 1.0, 6);  // 36 rows
+  const Eigen::Index n = a.rows();
+  const vec<double> b = vec<double>::Random(n);
+  const Eigen::MatrixXd small_pre = Eigen::MatrixXd::Identity(n - 4, n - 4);
+  block_ilu<double, 4> other_ilu;
+  other_ilu.compute(convection_diffusion<double, 4>(2, 3, 4, 1.0, 1.0, 6));
+  auto short_result = [&](const vec<double>& in, vec<double>& out) { out = in.head(in.size() - 1); };
+  auto long_result = [&](const vec<double>& in, vec<double>& out) {
+    out.resize(in.size() + 2);
+    out << in, 0.0, 0.0;
+  };
+  for (auto method : all_methods) {
+    krylov_options o;
+    o.max_iterations = 20;
+    vec<double> x;
+    EXPECT_THROW(run(method, a, small_pre, b, x, o), input_error);
+    EXPECT_THROW(run(method, a, other_ilu, b, x, o), input_error);
+    EXPECT_TRUE(contains(input_error_of([&] { run(method, short_result, identity_preconditioner{}, b, x, o); }),
+                         std::to_string(n - 1)));
+    EXPECT_THROW(run(method, long_result, identity_preconditioner{}, b, x, o), input_error);
+    EXPECT_THROW(run(method, a, short_result, b, x, o), input_error);
+  }
+}
+
+// NaN or Inf in the initial guess: refused with the entry named (the old code iterated on NaN
+// and returned a failed report).
+TEST(Krylov, NonFiniteInitialGuessIsRefused) {
+  const auto a = convection_diffusion<double, 4>(3, 3, 4, 1.0, 1.0, 7);
+  const vec<double> b = vec<double>::Random(a.rows());
+  for (auto method : all_methods) {
+    for (double bad : {std::nan(""), std::numeric_limits<double>::infinity()}) {
+      vec<double> x = vec<double>::Zero(a.rows());
+      x[7] = bad;
+      const std::string msg = input_error_of([&] { run(method, a, identity_preconditioner{}, b, x, krylov_options{}); });
+      EXPECT_TRUE(contains(msg, "initial guess")) << msg;
+      EXPECT_TRUE(contains(msg, "entry 7")) << msg;
+    }
+  }
+}
+
+// Every option out of its range is refused by every method, naming the option and its value:
+// an infinite tolerance made the old code report convergence at once with any x.
+TEST(Krylov, InvalidOptionsAreRefusedNamingTheOption) {
+  const auto a = convection_diffusion<double, 4>(3, 3, 4, 1.0, 1.0, 8);
+  const vec<double> b = vec<double>::Random(a.rows());
+  const double inf = std::numeric_limits<double>::infinity(), nan = std::nan("");
+  struct bad_option {
+    const char* name;
+    void (*set)(krylov_options&);
+  };
+  const bad_option bad[] = {
+      {"relative_tolerance", [](krylov_options& o) { o.relative_tolerance = std::numeric_limits<double>::infinity(); }},
+      {"relative_tolerance", [](krylov_options& o) { o.relative_tolerance = std::nan(""); }},
+      {"relative_tolerance", [](krylov_options& o) { o.relative_tolerance = -1e-8; }},
+      {"absolute_tolerance", [](krylov_options& o) { o.absolute_tolerance = std::numeric_limits<double>::infinity(); }},
+      {"absolute_tolerance", [](krylov_options& o) { o.absolute_tolerance = -1.0; }},
+      {"restart", [](krylov_options& o) { o.restart = 0; }},
+      {"max_iterations", [](krylov_options& o) { o.max_iterations = -1; }},
+  };
+  (void)inf;
+  (void)nan;
+  for (auto method : all_methods)
+    for (const auto& opt : bad) {
+      krylov_options o;
+      opt.set(o);
+      vec<double> x;
+      const std::string msg = input_error_of([&] { run(method, a, identity_preconditioner{}, b, x, o); });
+      EXPECT_TRUE(contains(msg, opt.name)) << msg;
+    }
+  // a huge restart is fine: the basis is never longer than the iterations allowed
+  krylov_options big;
+  big.restart = std::numeric_limits<int>::max();
+  big.max_iterations = 200;
+  vec<double> x;
+  EXPECT_TRUE(gmres(a, identity_preconditioner{}, b, x, big).converged);
+  vec<double> y;
+  EXPECT_TRUE(gcr(a, identity_preconditioner{}, b, y, big).converged);
+}
+
+// b = 0 with a nonzero initial guess: x = 0 is the exact solution of any linear system; every
+// method returns it at once (the old GMRES iterated to the limit, approaching 0 only up to
+// rounding), real and complex.
+TEST(Krylov, ZeroRightHandSideReturnsTheExactZeroSolution) {
+  const auto a = convection_diffusion<double, 4>(6, 6, 4, 2.0, 1.0, 9);
+  const auto ac = shifted(a, cd(0, 0.5));
+  for (auto method : all_methods) {
+    krylov_options o;
+    o.max_iterations = 500;
+    vec<double> x = vec<double>::Random(a.rows());
+    const auto rep = run(method, a, identity_preconditioner{}, vec<double>(vec<double>::Zero(a.rows())), x, o);
+    EXPECT_TRUE(rep.converged) << rep.method;
+    EXPECT_EQ(rep.iterations, 0) << rep.method;
+    EXPECT_EQ(rep.relative_residual, 0.0) << rep.method;
+    EXPECT_TRUE(contains(rep.reason, "zero right-hand side")) << rep.reason;
+    EXPECT_GT(rep.initial_residual, 0.0) << rep.method;  // ||A x0||: the guess was not a solution
+    EXPECT_EQ(x.norm(), 0.0) << rep.method;
+    vec<cd> z = vec<cd>::Random(a.rows());
+    const auto repc = run(method, ac, identity_preconditioner{}, vec<cd>(vec<cd>::Zero(a.rows())), z, o);
+    EXPECT_TRUE(repc.converged);
+    EXPECT_EQ(z.norm(), 0.0) << repc.method;
   }
 }

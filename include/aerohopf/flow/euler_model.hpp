@@ -32,7 +32,10 @@
 #include <array>
 #include <cmath>
 #include <numbers>
+#include <optional>
+#include <sstream>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "../error.hpp"
@@ -139,13 +142,16 @@ class euler_model {
   std::size_t cell_offset(int block) const { return offset_[block]; }
   const std::vector<halo_cell>& halos() const { return halos_; }
 
-  /// Moves the grid: new points and point velocities (same block shapes). Validated (positive
-  /// volumes) before anything is changed.
+  /// Moves the grid: new points and point velocities (the model's block count and shapes; see
+  /// compute_metrics for the velocities). Validated (shapes, positive volumes) before anything
+  /// is changed.
   void set_grid_motion(const multiblock_points<double, Dim>& points, const multiblock_points<double, Dim>* velocities) {
-    auto m = compute_metrics<double, Dim>(points, velocities);
+    require_size(points.blocks.size(), grid_.points.blocks.size(), "euler_model::set_grid_motion",
+                 "the block list of the points (blocks)");
     for (std::size_t b = 0; b < points.blocks.size(); ++b)
-      require(b < grid_.points.blocks.size() && points.blocks[b].points == grid_.points.blocks[b].points,
-              "set_grid_motion: block ", b, " has a different shape");
+      require(points.blocks[b].points == grid_.points.blocks[b].points, "euler_model::set_grid_motion: block ", b,
+              " has a different shape from the model's");
+    auto m = compute_metrics<double, Dim>(points, velocities);
     grid_.points = points;
     metrics_ = std::move(m);
     for (const auto& h : halos_) {
@@ -155,7 +161,10 @@ class euler_model {
   }
 
   /// Circulation of the far-field point vortex (used with options().vortex_far_field).
-  void set_circulation(double gamma) { circulation_ = gamma; }
+  void set_circulation(double gamma) {
+    require(std::isfinite(gamma), "euler_model::set_circulation: circulation ", gamma, " is not finite");
+    circulation_ = gamma;
+  }
   double circulation() const { return circulation_; }
 
   /// Free stream plus the compressible point vortex (2D): isentropic, same total enthalpy.
@@ -185,9 +194,64 @@ class euler_model {
     return v;
   }
 
-  /// R(w) with the model's own (double) metrics.
+  /// Every entry point that takes a state (residuals, Jacobians, spectral radius, forces)
+  /// checks its size (require_size; Eigen's assertions are off in Release builds) and refuses
+  /// a cell whose density or pressure is not positive and finite (require_physical): such a
+  /// state has a NaN sound speed that turns every wave-sign test of the Osher flux false, which
+  /// gives finite garbage and no error. The physical check is one pass over the state, under 1%
+  /// of a residual evaluation (double or taylor<>), so it is never skipped.
+  ///
+  /// An interior cell whose density or pressure is not positive and finite.
+  struct state_defect {
+    int block;
+    index_d<Dim> cell;   // (i, j[, k]) within the block
+    std::size_t global;  // cell number in the state vector (values global * nv ...)
+    double density, pressure;
+  };
+
+  /// First interior cell of w (n_cells() * nv values, not checked: internal) whose density or
+  /// pressure is not positive and finite, judged on the value part of the scalar (to_double:
+  /// the constant term of a taylor<> jet, the leading double of dd_real / qd_real). The one
+  /// physical-state test of the flow layer: is_physical() (a solver's acceptance of a step) and
+  /// require_physical() (the entry checks) both are this. NaN anywhere in a cell's state fails
+  /// it (!(x > 0)).
+  template <class S>
+  std::optional<state_defect> first_nonphysical_cell(const S* w) const {
+    for (std::size_t b = 0; b + 1 < offset_.size(); ++b)
+      for (std::size_t c = offset_[b]; c < offset_[b + 1]; ++c) {
+        state<double, Dim> s;
+        for (int v = 0; v < nv; ++v) s[v] = to_double(w[c * nv + v]);
+        const auto q = to_primitive<double, Dim>(s);
+        if (!(q.rho > 0.0 && q.p > 0.0 && std::isfinite(q.rho) && std::isfinite(q.p)))
+          return state_defect{static_cast<int>(b), unravel<Dim>(c - offset_[b], grid_.topology.cells[b]), c, q.rho, q.p};
+      }
+    return std::nullopt;
+  }
+
+  /// true if w has the model's size and every cell positive, finite density and pressure.
+  template <class S>
+  bool is_physical(const vec<S>& w) const {
+    require_size(w.size(), size(), "euler_model::is_physical", "state");
+    return !first_nonphysical_cell<S>(w.data());
+  }
+
+  /// Throws input_error("<where>: block b cell (i,j[,k]) (state cell c): density .., pressure ..
+  /// ...") for the first non-physical cell of w (n_cells() * nv values, not checked).
+  template <class S>
+  void require_physical(const S* w, std::string_view where) const {
+    const auto d = first_nonphysical_cell<S>(w);
+    if (!d) return;
+    std::ostringstream ij;
+    for (int e = 0; e < Dim; ++e) ij << (e ? "," : "") << d->cell[e];
+    throw input_error(aerohopf::internal::concat(where, ": block ", d->block, " cell (", ij.str(), ") (state cell ",
+                                                 d->global, "): density ", d->density, ", pressure ", d->pressure,
+                                                 ": not a physical state (both must be positive and finite)"));
+  }
+
+  /// R(w) with the model's own (double) metrics. Checks the size and the physical state of w.
   template <class S>
   vec<S> residual(const vec<S>& w) const {
+    require_size(w.size(), size(), "euler_model::residual", "state");
     vec<S> r(size());
     if constexpr (std::is_same_v<S, double>) {
       residual<S>(metrics_, w.data(), r.data());
@@ -197,17 +261,23 @@ class euler_model {
     return r;
   }
 
-  /// R(w) with given metrics (e.g. of a grid moved by a taylor<> structural state).
+  /// R(w) with given metrics (e.g. of a grid moved by a taylor<> structural state). Checks the
+  /// metrics' shapes, the size and the physical state of w.
   template <class S>
   vec<S> residual(const grid_metrics<S, Dim>& m, const vec<S>& w) const {
+    require_size(w.size(), size(), "euler_model::residual", "state");
     vec<S> r(size());
     residual<S>(m, w.data(), r.data());
     return r;
   }
 
+  /// Internal form: w and r point to at least size() values each (NOT checked; a coupled
+  /// system passes the flow part of its longer state this way). The metrics and the physical
+  /// state of the size() values read are checked.
   template <class S>
   void residual(const grid_metrics<S, Dim>& m, const S* w, S* r) const {
     check_metrics(m);
+    require_physical<S>(w, "euler_model::residual");
     std::vector<std::vector<state<S, Dim>>> padded;
     fill_padded<S>(m, w, padded);
     std::vector<std::vector<primitive<S, Dim>>> prim(padded.size());
@@ -367,6 +437,7 @@ class euler_model {
     double cp;
   };
   std::vector<wall_face> wall_faces(const vec<double>& w) const {
+    check_state_vector(w, "euler_model::wall_faces");
     std::vector<std::vector<state<double, Dim>>> padded;
     fill_padded<double>(metrics_, w.data(), padded);
     std::vector<wall_face> out;
@@ -398,6 +469,7 @@ class euler_model {
   }
 
   force_coefficients forces(const vec<double>& w) const {
+    check_state_vector(w, "euler_model::forces");
     force_coefficients c;
     const double pinf = fs_.pressure();
     for (const auto& f : wall_faces(w)) {
@@ -427,6 +499,7 @@ class euler_model {
   /// Sum over the faces of a cell of (|u.n - s_n| + c) |S|: the local time step is
   /// CFL * V / this (spectral radius of the flux Jacobian, first-order states).
   vec<double> spectral_radius(const vec<double>& w) const {
+    check_state_vector(w, "euler_model::spectral_radius");
     vec<double> rad = vec<double>::Zero(static_cast<Eigen::Index>(n_cells()));
     std::vector<std::vector<state<double, Dim>>> padded;
     fill_padded<double>(metrics_, w.data(), padded);
@@ -468,7 +541,8 @@ class euler_model {
   }
 
   /// Fills per-block padded arrays (interior copied from w, halos derived from donors,
-  /// unused corners set to the free stream).
+  /// unused corners set to the free stream). Internal: w must hold size() values (not checked;
+  /// every public entry point checks before calling this).
   template <class S>
   void fill_padded(const grid_metrics<S, Dim>& m, const S* w, std::vector<std::vector<state<S, Dim>>>& padded) const {
     const auto winf = fs_.conservative_state<S, Dim>();
@@ -528,12 +602,30 @@ class euler_model {
     return opt_.force_tag.empty() || grid_.topology.patches[patch].tag == opt_.force_tag;
   }
 
+  /// Shapes of given metrics: the model's blocks and cells, and arrays of the sizes these imply
+  /// (metrics are plain data a caller may have built or edited).
   template <class S>
   void check_metrics(const grid_metrics<S, Dim>& m) const {
     require(m.blocks.size() == pdims_.size(), "euler_model: metrics have ", m.blocks.size(), " blocks, model has ",
             pdims_.size());
-    for (std::size_t b = 0; b < pdims_.size(); ++b)
-      require(m.blocks[b].cells == grid_.topology.cells[b], "euler_model: metrics of block ", b, " have a different shape");
+    for (std::size_t b = 0; b < pdims_.size(); ++b) {
+      const auto& mb = m.blocks[b];
+      require(mb.cells == grid_.topology.cells[b], "euler_model: metrics of block ", b, " have a different shape");
+      require(mb.volume.size() == product<Dim>(mb.cells), "euler_model: metrics of block ", b, " have ",
+              mb.volume.size(), " volumes for ", product<Dim>(mb.cells), " cells");
+      for (int d = 0; d < Dim; ++d) {
+        const std::size_t nf = product<Dim>(mb.face_dims(d));
+        require(mb.normal[d].size() == nf && mb.speed[d].size() == nf, "euler_model: metrics of block ", b, " have ",
+                mb.normal[d].size(), " area vectors and ", mb.speed[d].size(), " face speeds normal to axis ", d,
+                ", expected ", nf);
+      }
+    }
+  }
+
+  /// Size and physical state of a double state vector.
+  void check_state_vector(const vec<double>& w, std::string_view where) const {
+    require_size(w.size(), size(), where, "state");
+    require_physical<double>(w.data(), where);
   }
 
   void build_layout() {

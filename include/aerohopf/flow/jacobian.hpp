@@ -96,14 +96,16 @@ std::vector<std::pair<Eigen::Index, Eigen::Index>> jacobian_pattern(const euler_
 }
 
 /// Assembles dR/dw (R = dw/dt) at state w into a (pattern set here if a is empty or has the
-/// wrong size, otherwise reused with set_zero()).
+/// wrong size, otherwise reused with set_zero()). The size and the physical state of w are
+/// checked before a is touched.
 template <int Dim>
 void assemble_jacobian(const euler_model<Dim>& m, const vec<double>& w, jacobian_kind kind,
                        block_sparse_matrix<double, Dim + 2>& a) {
   constexpr int nv = Dim + 2;
   using jet = taylor<double, 1>;
   using block = Eigen::Matrix<double, nv, nv>;
-  require(w.size() == m.size(), "assemble_jacobian: state has ", w.size(), " entries, model has ", m.size());
+  require_size(w.size(), m.size(), "assemble_jacobian", "state");
+  m.template require_physical<double>(w.data(), "assemble_jacobian");
   const auto ncell = static_cast<Eigen::Index>(m.n_cells());
   if (a.block_rows() != ncell) a.set_pattern(ncell, ncell, jacobian_pattern<Dim>(m, kind));
   a.set_zero(false);

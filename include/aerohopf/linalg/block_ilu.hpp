@@ -15,6 +15,9 @@
 //                 eliminates; no allocation; once per matrix
 //   apply(r, z)   z = (LU)^{-1} r by forward and backward block substitution
 // compute(a) does both (the symbolic phase only when the pattern changed).
+// A factorize() that throws (non-finite block, singular pivot, pattern other than the analysed
+// one) leaves no usable factors: apply() then throws singular_matrix_error naming the failure,
+// until a factorisation succeeds (never the stale factors of an earlier matrix).
 //
 // The diagonal blocks of U are stored INVERTED (LU-factored once with partial pivoting, then
 // inverted), so the triangular solves and the elimination only multiply blocks.
@@ -244,15 +247,50 @@ class block_ilu {
     work_.resize(static_cast<index>(n) * bs_);
     analysed_ = true;
     factorized_ = false;
+    failure_.clear();
   }
 
   /// Numeric phase for a matrix with the analysed pattern. Throws input_error for non-finite
-  /// blocks and singular_matrix_error for a singular pivot block (naming the block row).
+  /// blocks or another pattern and singular_matrix_error for a singular pivot block (naming the
+  /// block row); after any of these apply() refuses until a factorisation succeeds.
   void factorize(const matrix_type& a) {
     require(analysed_, opt_.context, ": factorize() before analyze()");
+    factorized_ = false;
+    try {
+      factorize_numeric(a);
+    } catch (const error& e) {
+      failure_ = e.what();
+      throw;
+    }
+    failure_.clear();
+    factorized_ = true;
+  }
+
+  /// z = M^{-1} r (original numbering). r and z must not alias. Not thread-safe (workspace).
+  void apply(const vector_type& r, vector_type& z) const {
+    if (!factorized_ && !failure_.empty())
+      throw singular_matrix_error(
+          internal::concat(opt_.context, ": apply() refused: the last factorisation failed (", failure_, ")"));
+    require(factorized_, opt_.context, ": apply() before factorize()");
+    require(r.size() == rows() && z.size() == rows(), opt_.context, ": apply: vector sizes ", r.size(), ", ",
+            z.size(), ", expected ", rows());
+    apply_factors(r, z);
+  }
+
+  index rows() const { return index(n_) * bs_; }
+  index block_rows() const { return n_; }
+  /// Non-zero blocks of the preconditioner (L + U + diagonal): its storage in blocks.
+  index nonzero_blocks() const { return static_cast<index>(col_.size()); }
+  /// perm[new] = old (empty without reordering).
+  const std::vector<int>& permutation() const { return perm_; }
+  /// Factor pattern in the (possibly permuted) numbering, for inspection.
+  const std::vector<int>& factor_row_ptr() const { return row_ptr_; }
+  const std::vector<int>& factor_col_index() const { return col_; }
+
+ private:
+  void factorize_numeric(const matrix_type& a) {
     require(same_pattern(a), opt_.context, ": matrix pattern differs from the analysed one (", a.block_rows(),
             " block rows, ", a.nonzero_blocks(), " blocks vs ", n_, ", ", a_col_.size(), ")");
-    factorized_ = false;
     const index bb = bs_ * bs_;
     for (int sl : fill_slots_) std::fill_n(val_.data() + index(sl) * bb, bb, Scalar(0.0));
     const auto& av = a.values();
@@ -292,7 +330,6 @@ class block_ilu {
         for (int q = row_ptr_[i]; q < row_ptr_[i + 1]; ++q) pos_[col_[q]] = -1;
         invert_pivot(i);
       }
-      factorized_ = true;
       return;
     }
     for (int i = 0; i < n_; ++i) {
@@ -310,14 +347,10 @@ class block_ilu {
       for (int q = row_ptr_[i]; q < row_ptr_[i + 1]; ++q) pos_[col_[q]] = -1;
       invert_pivot(i);
     }
-    factorized_ = true;
   }
 
-  /// z = M^{-1} r (original numbering). r and z must not alias. Not thread-safe (workspace).
-  void apply(const vector_type& r, vector_type& z) const {
-    require(factorized_, opt_.context, ": apply() before factorize()");
-    require(r.size() == rows() && z.size() == rows(), opt_.context, ": apply: vector sizes ", r.size(), ", ",
-            z.size(), ", expected ", rows());
+  /// apply() after its checks.
+  void apply_factors(const vector_type& r, vector_type& z) const {
     const index b = bs_;
     Scalar* w = perm_.empty() ? z.data() : work_.data();
     constexpr bool fast = internal::has_fast_block_kernel_v<Scalar, B>;
@@ -375,17 +408,6 @@ class block_ilu {
         z.template segment<B>(index(perm_[i]) * b, b) = Eigen::Map<const segment_type>(w + index(i) * b, b);
   }
 
-  index rows() const { return index(n_) * bs_; }
-  index block_rows() const { return n_; }
-  /// Non-zero blocks of the preconditioner (L + U + diagonal): its storage in blocks.
-  index nonzero_blocks() const { return static_cast<index>(col_.size()); }
-  /// perm[new] = old (empty without reordering).
-  const std::vector<int>& permutation() const { return perm_; }
-  /// Factor pattern in the (possibly permuted) numbering, for inspection.
-  const std::vector<int>& factor_row_ptr() const { return row_ptr_; }
-  const std::vector<int>& factor_col_index() const { return col_; }
-
- private:
   bool same_pattern(const matrix_type& a) const {
     return a.block_rows() == n_ && a.block_size() == bs_ && a.row_ptr() == a_row_ptr_ && a.col_index() == a_col_;
   }
@@ -422,6 +444,7 @@ class block_ilu {
 
   block_ilu_options opt_;
   bool analysed_ = false, factorized_ = false;
+  std::string failure_;  // why the last factorize() failed ("" after a success)
   index bs_ = (B == Eigen::Dynamic ? 1 : B);
   int n_ = 0;
   std::vector<int> a_row_ptr_, a_col_;  // pattern of the analysed matrix

@@ -620,6 +620,7 @@ class bordered_operator {
     require(d_.cols() == k && u_.rows() == n && u_.cols() == k && vt_.rows() == k && vt_.cols() == n,
             "bordered_operator: border columns ", u_.rows(), "x", u_.cols(), ", border rows ", vt_.rows(), "x",
             vt_.cols(), ", corner ", d_.rows(), "x", d_.cols(), " inconsistent with n = ", n);
+    require_operator_size(a, n, "bordered_operator", "inner operator");
     x1_.resize(n);
     y1_.resize(n);
   }
@@ -656,6 +657,7 @@ class bordered_preconditioner {
  public:
   template <class Op>
   bordered_preconditioner(const bordered_operator<Op, S>& a, const Pre& m) : m_(&m), n_(a.rows() - a.border_size()) {
+    require_operator_size(m, n_, "bordered_preconditioner", "inner preconditioner");
     const auto k = a.border_size();
     w_.resize(n_, k);
     vec<S> col(n_), z(n_);
@@ -673,7 +675,11 @@ class bordered_preconditioner {
     r1_.resize(n_);
     z1_.resize(n_);
   }
+  Eigen::Index rows() const { return n_ + w_.cols(); }
+  /// z = M_bordered^{-1} r; r and z of rows() entries (checked once per call).
   void apply(const vec<S>& r, vec<S>& z) const {
+    require(r.size() == rows() && z.size() == rows(), "bordered_preconditioner::apply: vector sizes ", r.size(), ", ",
+            z.size(), ", expected ", rows());
     const auto k = w_.cols();
     r1_ = r.head(n_);
     apply_operator<S>(*m_, r1_, z1_);

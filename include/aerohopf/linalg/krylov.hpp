@@ -17,6 +17,12 @@
 // the TRUE residual (recomputed at restarts and at the end; reported as relative_residual).
 // Failure is returned in the report (converged = false, reason); with throw_on_failure a
 // convergence_error with the context, method, iteration and residual is thrown instead.
+// Input is checked at the entry, before x is touched (input_error naming the option, vector
+// or operator): options (validate_krylov_options), the sizes of b, x0 and of the operator and
+// preconditioner where they report them (require_operator_size), finite b and x0; a matrix-free
+// operator's or preconditioner's result is checked for size after every application.
+// b = 0: x = 0 is the exact solution of every linear system, returned at once (no iteration,
+// reason "zero right-hand side ...").
 //
 // Iteration counts: GCR/GMRES count one step per operator product; TFQMR and BiCGSTAB count
 // one iteration per TWO operator products (operator_applications gives the comparable cost).
@@ -24,7 +30,9 @@
 
 #include <cmath>
 #include <complex>
+#include <algorithm>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "../error.hpp"
@@ -62,6 +70,17 @@ struct krylov_report {
   std::vector<double> residual_history; ///< relative residual (estimate) after each iteration, [0] initial
 };
 
+/// Throws input_error("<where>: <option> <value> must be ...") for an option out of range:
+/// tolerances finite and >= 0 (an infinite one accepts any x), restart >= 1, max_iterations >= 0.
+inline void validate_krylov_options(const krylov_options& opt, std::string_view where) {
+  require(std::isfinite(opt.relative_tolerance) && opt.relative_tolerance >= 0, where, ": relative_tolerance ",
+          opt.relative_tolerance, " must be finite and >= 0");
+  require(std::isfinite(opt.absolute_tolerance) && opt.absolute_tolerance >= 0, where, ": absolute_tolerance ",
+          opt.absolute_tolerance, " must be finite and >= 0");
+  require(opt.restart >= 1, where, ": restart ", opt.restart, " must be >= 1");
+  require(opt.max_iterations >= 0, where, ": max_iterations ", opt.max_iterations, " must be >= 0");
+}
+
 namespace internal {
 
 /// Shared bookkeeping of the four methods: counting, history, stopping test, final report.
@@ -76,27 +95,54 @@ struct krylov_state {
   krylov_report rep;
   double target = 0.0;
 
+  std::string where;  // "<context>: <method>"
+
+  /// Checks everything the caller passed (x untouched until they pass); x empty = zero guess.
   krylov_state(const char* name, const Op& a_, const Pre& m_, const vec<S>& b_, vec<S>& x_, const krylov_options& o)
-      : a(a_), m(m_), b(b_), x(x_), opt(o) {
+      : a(a_), m(m_), b(b_), x(x_), opt(o), where(concat(o.context, ": ", name)) {
     rep.method = name;
-    require(opt.max_iterations >= 0 && opt.restart >= 1 && opt.relative_tolerance >= 0 && opt.absolute_tolerance >= 0,
-            opt.context, ": ", name, ": invalid options (max_iterations ", opt.max_iterations, ", restart ",
-            opt.restart, ", tolerances ", opt.relative_tolerance, ", ", opt.absolute_tolerance, ")");
-    if (x.size() == 0) x = vec<S>::Zero(b.size());
-    require(x.size() == b.size(), opt.context, ": ", name, ": initial guess has ", x.size(), " entries, rhs ",
-            b.size());
+    validate_krylov_options(opt, where);
+    const Eigen::Index n = b.size();
+    require_operator_size(a, n, where, "operator");
+    require_operator_size(m, n, where, "preconditioner");
+    require_finite(b, where, "right-hand side");
+    if (x.size() != 0) {
+      require_size(x.size(), n, where, "initial guess");
+      require_finite(x, where, "initial guess");
+    }
     rep.rhs_norm = static_cast<double>(b.norm());
-    require(std::isfinite(rep.rhs_norm), opt.context, ": ", name, ": right-hand side is not finite");
+    require(std::isfinite(rep.rhs_norm), where, ": right-hand side norm overflows (", rep.rhs_norm, ")");
+    if (x.size() == 0) x = vec<S>::Zero(n);
     target = std::max(opt.relative_tolerance * rep.rhs_norm, opt.absolute_tolerance);
   }
   double scale() const { return rep.rhs_norm > 0 ? rep.rhs_norm : 1.0; }
+  /// Basis length of GCR(m)/GMRES(m): restart, but never more than the iterations allowed (the
+  /// same iterates; a huge restart would allocate n (restart + 1) scalars for nothing).
+  int basis_size() const { return std::min(opt.restart, std::max(opt.max_iterations, 1)); }
   void op(const vec<S>& in, vec<S>& out) {
     apply_operator<S>(a, in, out);
     ++rep.operator_applications;
+    if (out.size() != in.size()) require_size(out.size(), in.size(), where, "operator result");
   }
   void pre(const vec<S>& in, vec<S>& out) {
     apply_operator<S>(m, in, out);
     ++rep.preconditioner_applications;
+    if (out.size() != in.size()) require_size(out.size(), in.size(), where, "preconditioner result");
+  }
+  /// b = 0: x = 0 solves A x = b exactly for any A. Reports ||A x0|| as the initial residual.
+  bool zero_rhs() const { return rep.rhs_norm == 0.0; }
+  krylov_report zero_solution() {
+    if (!x.isZero(0.0)) {
+      vec<S> ax(b.size());
+      op(x, ax);
+      rep.initial_residual = static_cast<double>(ax.norm());
+    }
+    x.setZero();
+    record(rep.initial_residual);
+    rep.relative_residual = 0.0;
+    rep.converged = true;
+    rep.reason = "converged (zero right-hand side: x = 0 is the exact solution)";
+    return rep;
   }
   /// r = b - A x; returns ||r||.
   double true_residual(vec<S>& r, vec<S>& tmp) {
@@ -132,9 +178,10 @@ struct krylov_state {
 template <class S, class Op, class Pre>
 krylov_report gmres(const Op& a, const Pre& m_pre, const vec<S>& b, vec<S>& x, const krylov_options& opt = {}) {
   internal::krylov_state<S, Op, Pre> st("GMRES", a, m_pre, b, x, opt);
+  if (st.zero_rhs()) return st.zero_solution();
   using real = real_of_t<S>;
   const Eigen::Index n = b.size();
-  const int m = opt.restart;
+  const int m = st.basis_size();
   vec<S> r(n), w(n), z(n);
   double beta = st.true_residual(r, w);
   st.rep.initial_residual = beta / st.scale();
@@ -228,9 +275,10 @@ krylov_report gmres(const Op& a, const Pre& m_pre, const vec<S>& b, vec<S>& x, c
 template <class S, class Op, class Pre>
 krylov_report gcr(const Op& a, const Pre& m_pre, const vec<S>& b, vec<S>& x, const krylov_options& opt = {}) {
   internal::krylov_state<S, Op, Pre> st("GCR", a, m_pre, b, x, opt);
+  if (st.zero_rhs()) return st.zero_solution();
   using real = real_of_t<S>;
   const Eigen::Index n = b.size();
-  const int m = opt.restart;
+  const int m = st.basis_size();
   vec<S> r(n), tmp(n);
   double rn = st.true_residual(r, tmp);
   st.rep.initial_residual = rn / st.scale();
@@ -275,6 +323,7 @@ krylov_report gcr(const Op& a, const Pre& m_pre, const vec<S>& b, vec<S>& x, con
 template <class S, class Op, class Pre>
 krylov_report bicgstab(const Op& a, const Pre& m_pre, const vec<S>& b, vec<S>& x, const krylov_options& opt = {}) {
   internal::krylov_state<S, Op, Pre> st("BiCGSTAB", a, m_pre, b, x, opt);
+  if (st.zero_rhs()) return st.zero_solution();
   const Eigen::Index n = b.size();
   vec<S> r(n), tmp(n);
   double rn = st.true_residual(r, tmp);
@@ -340,6 +389,7 @@ krylov_report bicgstab(const Op& a, const Pre& m_pre, const vec<S>& b, vec<S>& x
 template <class S, class Op, class Pre>
 krylov_report tfqmr(const Op& a, const Pre& m_pre, const vec<S>& b, vec<S>& x, const krylov_options& opt = {}) {
   internal::krylov_state<S, Op, Pre> st("TFQMR", a, m_pre, b, x, opt);
+  if (st.zero_rhs()) return st.zero_solution();
   using real = real_of_t<S>;
   const Eigen::Index n = b.size();
   vec<S> r(n), tmp(n);

@@ -12,6 +12,9 @@
 // BILU phase is redone only when the sparsity pattern changes, so a Newton loop pays it once.
 // A solve that does not reach the tolerance throws convergence_error (like direct_solver
 // throws on a singular matrix); last_report() gives the iteration history either way.
+// Options are validated at construction. A factorisation that fails (singular pivot block,
+// non-finite entries) throws singular_matrix_error from compute() / precondition_with() and
+// leaves the solver refusing solve() (singular_matrix_error) until a factorisation succeeds.
 #include <string>
 
 #include "block_ilu.hpp"
@@ -52,6 +55,7 @@ class krylov_solver {
       : opt_(std::move(options)), context_(std::move(context)) {
     if (B != Eigen::Dynamic) opt_.block_size = B;
     require(opt_.block_size > 0, context_, ": block size ", opt_.block_size, " <= 0");
+    validate_krylov_options(opt_.krylov, context_);
     block_ilu_options io;
     io.fill_level = opt_.fill_level;
     io.reorder_rcm = opt_.reorder_rcm;
@@ -62,14 +66,15 @@ class krylov_solver {
 
   krylov_solver& compute(const Matrix& a) {
     require(a.rows() == a.cols(), context_, ": matrix is ", a.rows(), "x", a.cols(), ", not square");
-    a_ = to_blocks(a);
-    if (own_preconditioner_) {
-      require(ilu_.rows() == a_.rows(), context_, ": preconditioner matrix (precondition_with) has ", ilu_.rows(),
-              " rows, operator ", a_.rows());
-    } else {
-      factor(a_);
-    }
+    block_matrix blocks = to_blocks(a);
+    if (own_preconditioner_)
+      require(ilu_.rows() == blocks.rows(), context_, ": preconditioner matrix (precondition_with) has ", ilu_.rows(),
+              " rows, operator ", blocks.rows());
+    computed_ = false;  // until the factorisation below has succeeded
+    a_ = std::move(blocks);
     n_ = a.rows();
+    if (!own_preconditioner_) factor(a_);
+    computed_ = true;
     return *this;
   }
 
@@ -86,6 +91,10 @@ class krylov_solver {
   /// Solves A x = b column by column (zero initial guess); throws convergence_error on failure.
   template <class Rhs>
   auto solve(const Eigen::MatrixBase<Rhs>& b) const {
+    if (!failure_.empty())
+      throw singular_matrix_error(
+          internal::concat(context_, ": solve() refused: the last factorisation failed (", failure_, ")"));
+    require(computed_, context_, ": solve() before compute()");
     require(b.rows() == n_, context_, ": right-hand side has ", b.rows(), " rows, matrix ", n_);
     Eigen::Matrix<scalar, Eigen::Dynamic, Rhs::ColsAtCompileTime> x(n_, b.cols());
     krylov_options o = opt_.krylov;
@@ -109,11 +118,17 @@ class krylov_solver {
     if constexpr (is_sparse_matrix_v<Matrix>) return block_matrix::from_sparse(a, opt_.block_size);
     else return block_matrix::from_sparse(a.sparseView(), opt_.block_size);
   }
+  /// BILU(k) of m; on failure records why (solve() refuses until a factorisation succeeds).
   void factor(const block_matrix& m) {
+    failure_.clear();
     try {
       ilu_.compute(m);
     } catch (const input_error& e) {  // non-finite matrix entries: same exception as direct_solver
+      failure_ = e.what();
       throw singular_matrix_error(e.what());
+    } catch (const error& e) {
+      failure_ = e.what();
+      throw;
     }
   }
 
@@ -123,6 +138,8 @@ class krylov_solver {
   block_ilu<scalar, B> ilu_;
   Eigen::Index n_ = 0;
   bool own_preconditioner_ = false;
+  bool computed_ = false;   // a_ holds the operator of the last successful compute()
+  std::string failure_;     // why the last factorisation failed ("" if it succeeded)
   mutable krylov_report report_;
 };
 
