@@ -515,152 +515,152 @@ hopf_curve_result trace_hopf_curve(const F& family, double nu0, const hopf_point
   // outside a corrector) ends the trace like a step failure: rethrown with the last point's
   // context (same type), or with throw_on_failure = false a step_failure stop keeping the points.
   try {
-  for (;;) {
-    const auto t_point = clock::now();
-    int attempts = 0;
-    bool exact_t = false;  // t is the exact tangent at x (not the secant)
-    std::optional<corrected> xn;
     for (;;) {
-      ++attempts;
-      const vec<double> xp = x + ds * t;
-      double c[3], value = 0;
-      for (int j = 0; j < 3; ++j) {
-        c[j] = sig[j] > 0 ? yv(t, j) / (sig[j] * sig[j]) : 0.0;
-        value += c[j] * yv(xp, j);
-      }
-      xn = correct(xp, s, c, value);
-      if (xn) {
-        // reject a corrector that wandered (another branch) or reversed the direction
-        const double moved = ydist(xn->x, xp);
-        const vec<double> d = xn->x - x;
-        const double dn = std::sqrt(ydot(d, d));
-        if (!(moved <= opt.corrector_distance * ds)) {
-          last_failure = internal::concat("corrector moved ", moved, " from the prediction (step ", ds, ")");
-          xn.reset();
-        } else if (!(ydot(d, t) > opt.min_cosine * dn)) {
-          // behind the last point, or far off the predicted direction: a jump to another
-          // sheet of a folded curve (measured on the heavy-case aerofoil near M = 0.84)
-          last_failure = "the corrected point lies behind the last point or off the predicted direction";
-          xn.reset();
+      const auto t_point = clock::now();
+      int attempts = 0;
+      bool exact_t = false;  // t is the exact tangent at x (not the secant)
+      std::optional<corrected> xn;
+      for (;;) {
+        ++attempts;
+        const vec<double> xp = x + ds * t;
+        double c[3], value = 0;
+        for (int j = 0; j < 3; ++j) {
+          c[j] = sig[j] > 0 ? yv(t, j) / (sig[j] * sig[j]) : 0.0;
+          value += c[j] * yv(xp, j);
         }
-      }
-      if (xn) break;
-      ++res.failed_correctors;
-      // First failure at this point: the secant is the chord of the last step and, where the
-      // curve bends sharply, points off the curve at any step size. Retry the same step along
-      // the exact tangent at x (oriented along the secant), then halve.
-      bool retry_same = false;
-      if (!exact_t && res.points.size() > 1) {
-        try {
-          double c[3];
-          for (int j = 0; j < 3; ++j) c[j] = sig[j] > 0 ? yv(t, j) / (sig[j] * sig[j]) : 0.0;
-          vec<double> te = exact_tangent(x, s, c);
-          if (ydot(te, t) < 0) te = -te;
-          t = std::move(te);
-          retry_same = true;
-        } catch (const error& e) {
-          last_failure += internal::concat(" (exact tangent failed: ", e.what(), ")");
+        xn = correct(xp, s, c, value);
+        if (xn) {
+          // reject a corrector that wandered (another branch) or reversed the direction
+          const double moved = ydist(xn->x, xp);
+          const vec<double> d = xn->x - x;
+          const double dn = std::sqrt(ydot(d, d));
+          if (!(moved <= opt.corrector_distance * ds)) {
+            last_failure = internal::concat("corrector moved ", moved, " from the prediction (step ", ds, ")");
+            xn.reset();
+          } else if (!(ydot(d, t) > opt.min_cosine * dn)) {
+            // behind the last point, or far off the predicted direction: a jump to another
+            // sheet of a folded curve (measured on the heavy-case aerofoil near M = 0.84)
+            last_failure = "the corrected point lies behind the last point or off the predicted direction";
+            xn.reset();
+          }
         }
-        exact_t = true;
-      }
-      if (opt.verbose && opt.log)
-        *opt.log << lab << ": step " << ds << " from nu = " << x[inu] << ", mu = " << x[imu] << " failed ("
-                 << last_failure << "), " << (retry_same ? "retrying along the exact tangent" : "halving") << "\n";
-      if (retry_same) continue;
-      ds *= 0.5;
-      if (ds < opt.min_step) {
-        const std::string why = internal::concat(
-            lab, ": step fell below min_step = ", opt.min_step, " after the point nu = ", x[inu], ", mu = ", x[imu],
-            ", omega = ", x[iom], " (point ", res.points.size() - 1, "); last attempted step ", 2 * ds,
-            ", last failure: ", last_failure,
-            opt.omega_scale == 0 && x[iom] < 1e-2 ? " (omega is small: a Bogdanov-Takens end? set omega_scale > 0)" : "");
-        if (opt.throw_on_failure) throw convergence_error(why);
-        return finish(hopf_curve_stop::step_failure, why);
-      }
-    }
-    vec<double> xnew = std::move(xn->x);
-    const int iters = xn->iterations;
-
-    // ---- Bogdanov-Takens: omega reaches zero (or below what the corrector resolves) or changes sign ----
-    const double omega_floor = xn->omega_floor;
-    if (xnew[iom] <= std::max(opt.omega_min, omega_floor)) {
-      // (mu, nu) are smooth in omega^2 along the curve: least squares of y = a + b omega^2
-      std::vector<const vec<double>*> pts = {&x, &xnew};
-      if (x_prev.size()) pts.push_back(&x_prev);
-      double s1 = 0, sz = 0, szz = 0;
-      double sy[2] = {0, 0}, szy[2] = {0, 0};
-      for (const vec<double>* q : pts) {
-        const double z = (*q)[iom] * (*q)[iom];
-        s1 += 1, sz += z, szz += z * z;
-        for (int j = 0; j < 2; ++j) sy[j] += (*q)[imu + j], szy[j] += z * (*q)[imu + j];
-      }
-      const double det = s1 * szz - sz * sz;
-      for (int j = 0; j < 2; ++j) {
-        const double a = std::abs(det) > 1e-300 ? (szz * sy[j] - sz * szy[j]) / det : xnew[imu + j];
-        (j == 0 ? res.bogdanov_takens_mu : res.bogdanov_takens_nu) = a;
-      }
-      if (xnew[iom] > omega_floor)  // a Hopf point with a resolved frequency
-        emit(make_point(xnew, iters, attempts, ydist(xnew, x), seconds_since(t_point), false));
-      return finish(hopf_curve_stop::bogdanov_takens,
-                    internal::concat("omega -> 0: the Hopf curve ends at a Bogdanov-Takens point near nu = ",
-                                     res.bogdanov_takens_nu, ", mu = ", res.bogdanov_takens_mu, " (last omega ",
-                                     xnew[iom], ")"));
-    }
-
-    // ---- landings on targets and bounds crossed by this step, in curve order ----
-    std::vector<std::pair<double, landing>> crossed;
-    for (const auto& l : lands) {
-      const double a = x[imu + l.row] - l.value, b = xnew[imu + l.row] - l.value;
-      if (a * b < 0 || (b == 0 && a != 0)) crossed.push_back({a / (a - b), l});
-    }
-    std::sort(crossed.begin(), crossed.end(), [](const auto& u, const auto& v) { return u.first < v.first; });
-    for (const auto& [theta, l] : crossed) {
-      const auto t_land = clock::now();
-      const vec<double> x0 = x + theta * (xnew - x);
-      double c[3] = {0, 0, 0};
-      c[l.row] = 1;
-      auto xl = correct(x0, s, c, l.value);
-      if (xl && !(xl->x[iom] > xl->omega_floor)) {
-        last_failure = internal::concat("the landed point has omega = ", xl->x[iom], ", not above the resolved frequency ",
-                                        xl->omega_floor);
-        xl.reset();
-      }
-      if (xl) {
-        emit(make_point(xl->x, xl->iterations, 1, ydist(xl->x, x), seconds_since(t_land), true));
-      } else {
+        if (xn) break;
+        ++res.failed_correctors;
+        // First failure at this point: the secant is the chord of the last step and, where the
+        // curve bends sharply, points off the curve at any step size. Retry the same step along
+        // the exact tangent at x (oriented along the secant), then halve.
+        bool retry_same = false;
+        if (!exact_t && res.points.size() > 1) {
+          try {
+            double c[3];
+            for (int j = 0; j < 3; ++j) c[j] = sig[j] > 0 ? yv(t, j) / (sig[j] * sig[j]) : 0.0;
+            vec<double> te = exact_tangent(x, s, c);
+            if (ydot(te, t) < 0) te = -te;
+            t = std::move(te);
+            retry_same = true;
+          } catch (const error& e) {
+            last_failure += internal::concat(" (exact tangent failed: ", e.what(), ")");
+          }
+          exact_t = true;
+        }
         if (opt.verbose && opt.log)
-          *opt.log << lab << ": landing on " << (l.row ? "nu = " : "mu = ") << l.value << " failed: " << last_failure
-                   << "\n";
-        if (!l.bound) res.missed_targets.push_back(l.value);
+          *opt.log << lab << ": step " << ds << " from nu = " << x[inu] << ", mu = " << x[imu] << " failed ("
+                   << last_failure << "), " << (retry_same ? "retrying along the exact tangent" : "halving") << "\n";
+        if (retry_same) continue;
+        ds *= 0.5;
+        if (ds < opt.min_step) {
+          const std::string why = internal::concat(
+              lab, ": step fell below min_step = ", opt.min_step, " after the point nu = ", x[inu], ", mu = ", x[imu],
+              ", omega = ", x[iom], " (point ", res.points.size() - 1, "); last attempted step ", 2 * ds,
+              ", last failure: ", last_failure,
+              opt.omega_scale == 0 && x[iom] < 1e-2 ? " (omega is small: a Bogdanov-Takens end? set omega_scale > 0)" : "");
+          if (opt.throw_on_failure) throw convergence_error(why);
+          return finish(hopf_curve_stop::step_failure, why);
+        }
       }
-      if (l.bound) {
-        if (!xl) emit(make_point(xnew, iters, attempts, ydist(xnew, x), seconds_since(t_point), false));
-        return finish(l.row ? hopf_curve_stop::nu_bounds : hopf_curve_stop::mu_bounds,
-                      internal::concat("reached ", l.row ? "nu = " : "mu = ", l.value,
-                                       xl ? "" : " (landing failed: the last point lies outside)"));
+      vec<double> xnew = std::move(xn->x);
+      const int iters = xn->iterations;
+
+      // ---- Bogdanov-Takens: omega reaches zero (or below what the corrector resolves) or changes sign ----
+      const double omega_floor = xn->omega_floor;
+      if (xnew[iom] <= std::max(opt.omega_min, omega_floor)) {
+        // (mu, nu) are smooth in omega^2 along the curve: least squares of y = a + b omega^2
+        std::vector<const vec<double>*> pts = {&x, &xnew};
+        if (x_prev.size()) pts.push_back(&x_prev);
+        double s1 = 0, sz = 0, szz = 0;
+        double sy[2] = {0, 0}, szy[2] = {0, 0};
+        for (const vec<double>* q : pts) {
+          const double z = (*q)[iom] * (*q)[iom];
+          s1 += 1, sz += z, szz += z * z;
+          for (int j = 0; j < 2; ++j) sy[j] += (*q)[imu + j], szy[j] += z * (*q)[imu + j];
+        }
+        const double det = s1 * szz - sz * sz;
+        for (int j = 0; j < 2; ++j) {
+          const double a = std::abs(det) > 1e-300 ? (szz * sy[j] - sz * szy[j]) / det : xnew[imu + j];
+          (j == 0 ? res.bogdanov_takens_mu : res.bogdanov_takens_nu) = a;
+        }
+        if (xnew[iom] > omega_floor)  // a Hopf point with a resolved frequency
+          emit(make_point(xnew, iters, attempts, ydist(xnew, x), seconds_since(t_point), false));
+        return finish(hopf_curve_stop::bogdanov_takens,
+                      internal::concat("omega -> 0: the Hopf curve ends at a Bogdanov-Takens point near nu = ",
+                                       res.bogdanov_takens_nu, ", mu = ", res.bogdanov_takens_mu, " (last omega ",
+                                       xnew[iom], ")"));
       }
+
+      // ---- landings on targets and bounds crossed by this step, in curve order ----
+      std::vector<std::pair<double, landing>> crossed;
+      for (const auto& l : lands) {
+        const double a = x[imu + l.row] - l.value, b = xnew[imu + l.row] - l.value;
+        if (a * b < 0 || (b == 0 && a != 0)) crossed.push_back({a / (a - b), l});
+      }
+      std::sort(crossed.begin(), crossed.end(), [](const auto& u, const auto& v) { return u.first < v.first; });
+      for (const auto& [theta, l] : crossed) {
+        const auto t_land = clock::now();
+        const vec<double> x0 = x + theta * (xnew - x);
+        double c[3] = {0, 0, 0};
+        c[l.row] = 1;
+        auto xl = correct(x0, s, c, l.value);
+        if (xl && !(xl->x[iom] > xl->omega_floor)) {
+          last_failure = internal::concat("the landed point has omega = ", xl->x[iom], ", not above the resolved frequency ",
+                                          xl->omega_floor);
+          xl.reset();
+        }
+        if (xl) {
+          emit(make_point(xl->x, xl->iterations, 1, ydist(xl->x, x), seconds_since(t_land), true));
+        } else {
+          if (opt.verbose && opt.log)
+            *opt.log << lab << ": landing on " << (l.row ? "nu = " : "mu = ") << l.value << " failed: " << last_failure
+                     << "\n";
+          if (!l.bound) res.missed_targets.push_back(l.value);
+        }
+        if (l.bound) {
+          if (!xl) emit(make_point(xnew, iters, attempts, ydist(xnew, x), seconds_since(t_point), false));
+          return finish(l.row ? hopf_curve_stop::nu_bounds : hopf_curve_stop::mu_bounds,
+                        internal::concat("reached ", l.row ? "nu = " : "mu = ", l.value,
+                                         xl ? "" : " (landing failed: the last point lies outside)"));
+        }
+        if (res.points.size() >= size_t(opt.max_points)) return finish(hopf_curve_stop::max_points, "max_points reached");
+        if (stop_requested) return finish(hopf_curve_stop::requested, "stop requested by stop_after");
+      }
+
+      // ---- accept ----
+      const double len = ydist(xnew, x);
+      arclength += len;
+      emit(make_point(xnew, iters, attempts, len, seconds_since(t_point), false));
       if (res.points.size() >= size_t(opt.max_points)) return finish(hopf_curve_stop::max_points, "max_points reached");
       if (stop_requested) return finish(hopf_curve_stop::requested, "stop requested by stop_after");
+      s = refresh_s(xnew);
+      x_prev = std::move(x);
+      rescale_p(x_prev, s);
+      t = xnew - x_prev;
+      const double tn = std::sqrt(ydot(t, t));
+      t /= tn;
+      x = std::move(xnew);
+      if (opt.detect_closed && arclength > 3 * len && ydist(x, x_first) < len)
+        return finish(hopf_curve_stop::closed_curve,
+                      internal::concat("the curve closed on its start after arclength ", arclength));
+      if (iters <= opt.fast_iterations) ds = std::min(opt.max_step, opt.growth * ds);
     }
-
-    // ---- accept ----
-    const double len = ydist(xnew, x);
-    arclength += len;
-    emit(make_point(xnew, iters, attempts, len, seconds_since(t_point), false));
-    if (res.points.size() >= size_t(opt.max_points)) return finish(hopf_curve_stop::max_points, "max_points reached");
-    if (stop_requested) return finish(hopf_curve_stop::requested, "stop requested by stop_after");
-    s = refresh_s(xnew);
-    x_prev = std::move(x);
-    rescale_p(x_prev, s);
-    t = xnew - x_prev;
-    const double tn = std::sqrt(ydot(t, t));
-    t /= tn;
-    x = std::move(xnew);
-    if (opt.detect_closed && arclength > 3 * len && ydist(x, x_first) < len)
-      return finish(hopf_curve_stop::closed_curve,
-                    internal::concat("the curve closed on its start after arclength ", arclength));
-    if (iters <= opt.fast_iterations) ds = std::min(opt.max_step, opt.growth * ds);
-  }
   } catch (const error& e) {
     const hopf_curve_point& lp = res.points.back();  // the start at least
     const std::string where = internal::curve_failure_context(lab, res.points.size(), lp.nu, lp.mu, lp.omega);

@@ -821,218 +821,218 @@ symmetric_hopf_curve_result trace_symmetric_hopf_curve(const F& family, double n
   // point's context (same type), or with throw_on_failure = false a step_failure stop keeping
   // the points.
   try {
-  for (;;) {
-    const auto t_point = clock::now();
-    int attempts = 0;
-    bool exact_t = false;
-    const vec<double> t_secant = t;  // the direction of travel so far (t may become the exact tangent)
-    joint_now = sopt.joint_equilibrium;
-    std::optional<corrected> xn;
-    bool kink_tried = false;  // the kink fallback at this step size
-    // Local parametrisation (file comment): the same step at fixed nu or mu at its value
-    // predicted along the secant; nu first (the kinks lie on lines nu = const) unless the
-    // curve is nearly vertical in nu there, then the other one (at a kink where one of
-    // them reverses, only the other crosses it). True: xn holds the accepted point.
-    auto kink_step = [&]() -> bool {
-      kink_tried = true;
-      const double rnu = std::abs(t_secant[inu]) / sig[1], rmu = std::abs(t_secant[imu]) / sig[0];
-      const int order[2] = {rnu >= 0.1 * rmu ? 1 : 0, rnu >= 0.1 * rmu ? 0 : 1};
-      const vec<double> xp = x + ds * t_secant;
-      for (int j : order) {
-        double c[3] = {0, 0, 0};
-        c[j] = 1;
-        auto xk = correct(xp, s, c, yv(xp, j), sopt.iterate_distance * ds);
-        if (xk) {
-          const double dist = ydist(xk->x, x);
-          const bool forward = ydot(vec<double>(xk->x - x), t_secant) > 0 && !revisits(xk->x, ds);
-          if (forward && dist <= sopt.kink_distance * ds) {
-            xn = std::move(xk);
-            ++res.kink_steps;
-            if (opt.verbose && opt.log)
-              *opt.log << lab << ": step " << ds << " from nu = " << x[inu] << ", mu = " << x[imu] << " taken at fixed "
-                       << (j ? "nu" : "mu") << " (a kink of the curve?)" << std::endl;
-            break;
-          }
-          last_failure = forward ? internal::concat("fixed-", j ? "nu" : "mu", " step landed ", dist,
-                                                    " from the last point (step ", ds, ")")
-                                 : internal::concat("fixed-", j ? "nu" : "mu", " step went back along the curve");
-        } else {
-          last_failure = internal::concat("fixed-", j ? "nu" : "mu", " step failed: ", last_failure);
-        }
-        if (opt.verbose && opt.log) *opt.log << lab << ": " << last_failure << std::endl;
-      }
-      return xn.has_value();
-    };
     for (;;) {
-      ++attempts;
-      const vec<double> xp = x + ds * t;
-      double c[3], value = 0;
-      for (int j = 0; j < 3; ++j) {
-        c[j] = sig[j] > 0 ? yv(t, j) / (sig[j] * sig[j]) : 0.0;
-        value += c[j] * yv(xp, j);
-      }
-      xn = correct(xp, s, c, value, sopt.iterate_distance * ds);
-      const bool diverged = !xn;  // the corrector failed (not: converged to a point rejected below)
-      if (xn) {
-        const double moved = ydist(xn->x, xp);
-        const vec<double> d = xn->x - x;
-        const double dn = std::sqrt(ydot(d, d));
-        if (!(moved <= opt.corrector_distance * ds)) {
-          last_failure = internal::concat("corrector moved ", moved, " from the prediction (step ", ds, ")");
-          xn.reset();
-        } else if (!(ydot(d, t) > opt.min_cosine * dn)) {
-          last_failure = "the corrected point lies behind the last point or off the predicted direction";
-          xn.reset();
-        } else if (!(ydot(d, t_secant) > 0)) {
-          // after the exact-tangent retry at a kink: a step back along the traced curve
-          last_failure = "the corrected point goes back along the traced curve";
-          xn.reset();
-        } else if (revisits(xn->x, ds)) {
-          last_failure = "the corrected point lies on a stretch of the curve traced before";
-          xn.reset();
+      const auto t_point = clock::now();
+      int attempts = 0;
+      bool exact_t = false;
+      const vec<double> t_secant = t;  // the direction of travel so far (t may become the exact tangent)
+      joint_now = sopt.joint_equilibrium;
+      std::optional<corrected> xn;
+      bool kink_tried = false;  // the kink fallback at this step size
+      // Local parametrisation (file comment): the same step at fixed nu or mu at its value
+      // predicted along the secant; nu first (the kinks lie on lines nu = const) unless the
+      // curve is nearly vertical in nu there, then the other one (at a kink where one of
+      // them reverses, only the other crosses it). True: xn holds the accepted point.
+      auto kink_step = [&]() -> bool {
+        kink_tried = true;
+        const double rnu = std::abs(t_secant[inu]) / sig[1], rmu = std::abs(t_secant[imu]) / sig[0];
+        const int order[2] = {rnu >= 0.1 * rmu ? 1 : 0, rnu >= 0.1 * rmu ? 0 : 1};
+        const vec<double> xp = x + ds * t_secant;
+        for (int j : order) {
+          double c[3] = {0, 0, 0};
+          c[j] = 1;
+          auto xk = correct(xp, s, c, yv(xp, j), sopt.iterate_distance * ds);
+          if (xk) {
+            const double dist = ydist(xk->x, x);
+            const bool forward = ydot(vec<double>(xk->x - x), t_secant) > 0 && !revisits(xk->x, ds);
+            if (forward && dist <= sopt.kink_distance * ds) {
+              xn = std::move(xk);
+              ++res.kink_steps;
+              if (opt.verbose && opt.log)
+                *opt.log << lab << ": step " << ds << " from nu = " << x[inu] << ", mu = " << x[imu] << " taken at fixed "
+                         << (j ? "nu" : "mu") << " (a kink of the curve?)" << std::endl;
+              break;
+            }
+            last_failure = forward ? internal::concat("fixed-", j ? "nu" : "mu", " step landed ", dist,
+                                                      " from the last point (step ", ds, ")")
+                                   : internal::concat("fixed-", j ? "nu" : "mu", " step went back along the curve");
+          } else {
+            last_failure = internal::concat("fixed-", j ? "nu" : "mu", " step failed: ", last_failure);
+          }
+          if (opt.verbose && opt.log) *opt.log << lab << ": " << last_failure << std::endl;
         }
-      }
-      if (xn) break;
-      ++res.failed_correctors;
-      joint_now = false;  // the retries of this step: nested steady solves (file comment)
-      // A corrector that diverged from the secant prediction: the kink fallback first (file comment)
-      if (diverged && sopt.kink_fallback && !kink_tried) {
+        return xn.has_value();
+      };
+      for (;;) {
+        ++attempts;
+        const vec<double> xp = x + ds * t;
+        double c[3], value = 0;
+        for (int j = 0; j < 3; ++j) {
+          c[j] = sig[j] > 0 ? yv(t, j) / (sig[j] * sig[j]) : 0.0;
+          value += c[j] * yv(xp, j);
+        }
+        xn = correct(xp, s, c, value, sopt.iterate_distance * ds);
+        const bool diverged = !xn;  // the corrector failed (not: converged to a point rejected below)
+        if (xn) {
+          const double moved = ydist(xn->x, xp);
+          const vec<double> d = xn->x - x;
+          const double dn = std::sqrt(ydot(d, d));
+          if (!(moved <= opt.corrector_distance * ds)) {
+            last_failure = internal::concat("corrector moved ", moved, " from the prediction (step ", ds, ")");
+            xn.reset();
+          } else if (!(ydot(d, t) > opt.min_cosine * dn)) {
+            last_failure = "the corrected point lies behind the last point or off the predicted direction";
+            xn.reset();
+          } else if (!(ydot(d, t_secant) > 0)) {
+            // after the exact-tangent retry at a kink: a step back along the traced curve
+            last_failure = "the corrected point goes back along the traced curve";
+            xn.reset();
+          } else if (revisits(xn->x, ds)) {
+            last_failure = "the corrected point lies on a stretch of the curve traced before";
+            xn.reset();
+          }
+        }
+        if (xn) break;
+        ++res.failed_correctors;
+        joint_now = false;  // the retries of this step: nested steady solves (file comment)
+        // A corrector that diverged from the secant prediction: the kink fallback first (file comment)
+        if (diverged && sopt.kink_fallback && !kink_tried) {
+          if (opt.verbose && opt.log)
+            *opt.log << lab << ": step " << ds << " from nu = " << x[inu] << ", mu = " << x[imu] << " failed ("
+                     << last_failure << "), trying it at fixed nu or mu" << std::endl;
+          if (kink_step()) break;
+        }
+        bool retry_same = false;
+        if (!exact_t && res.points.size() > 1) {
+          try {
+            double cc[3];
+            for (int j = 0; j < 3; ++j) cc[j] = sig[j] > 0 ? yv(t, j) / (sig[j] * sig[j]) : 0.0;
+            vec<double> te = exact_tangent(x, s, cc);
+            if (ydot(te, t) < 0) te = -te;
+            t = std::move(te);
+            retry_same = true;
+          } catch (const error& e) {
+            last_failure += internal::concat(" (exact tangent failed: ", e.what(), ")");
+          }
+          exact_t = true;
+        }
         if (opt.verbose && opt.log)
           *opt.log << lab << ": step " << ds << " from nu = " << x[inu] << ", mu = " << x[imu] << " failed ("
-                   << last_failure << "), trying it at fixed nu or mu" << std::endl;
-        if (kink_step()) break;
-      }
-      bool retry_same = false;
-      if (!exact_t && res.points.size() > 1) {
-        try {
-          double cc[3];
-          for (int j = 0; j < 3; ++j) cc[j] = sig[j] > 0 ? yv(t, j) / (sig[j] * sig[j]) : 0.0;
-          vec<double> te = exact_tangent(x, s, cc);
-          if (ydot(te, t) < 0) te = -te;
-          t = std::move(te);
-          retry_same = true;
-        } catch (const error& e) {
-          last_failure += internal::concat(" (exact tangent failed: ", e.what(), ")");
+                   << last_failure << "), " << (retry_same ? "retrying along the exact tangent" : "halving") << std::endl;
+        if (retry_same) continue;
+        if (sopt.kink_fallback && !kink_tried && kink_step()) break;
+        kink_tried = false;
+        ds *= 0.5;
+        if (ds < opt.min_step) {
+          const std::string why = internal::concat(
+              lab, ": step fell below min_step = ", opt.min_step, " after the point nu = ", x[inu], ", mu = ", x[imu],
+              ", omega = ", x[iom], " (point ", res.points.size() - 1, "); last attempted step ", 2 * ds,
+              ", last failure: ", last_failure);
+          if (opt.throw_on_failure) throw convergence_error(why);
+          return finish(hopf_curve_stop::step_failure, why);
         }
-        exact_t = true;
       }
-      if (opt.verbose && opt.log)
-        *opt.log << lab << ": step " << ds << " from nu = " << x[inu] << ", mu = " << x[imu] << " failed ("
-                 << last_failure << "), " << (retry_same ? "retrying along the exact tangent" : "halving") << std::endl;
-      if (retry_same) continue;
-      if (sopt.kink_fallback && !kink_tried && kink_step()) break;
-      kink_tried = false;
-      ds *= 0.5;
-      if (ds < opt.min_step) {
-        const std::string why = internal::concat(
-            lab, ": step fell below min_step = ", opt.min_step, " after the point nu = ", x[inu], ", mu = ", x[imu],
-            ", omega = ", x[iom], " (point ", res.points.size() - 1, "); last attempted step ", 2 * ds,
-            ", last failure: ", last_failure);
-        if (opt.throw_on_failure) throw convergence_error(why);
-        return finish(hopf_curve_stop::step_failure, why);
-      }
-    }
-    vec<double> xnew = std::move(xn->x);
-    const int iters = xn->iterations;
-    const double step_seconds = seconds_since(t_point);
-    // costs of this step, kept apart from those of landings emitted before xnew
-    const symmetric_hopf_curve_stats step_costs = std::exchange(acc, symmetric_hopf_curve_stats{});
-    auto add_step_costs = [&] {
-      acc.linear_iterations += step_costs.linear_iterations;
-      acc.steady_solves += step_costs.steady_solves;
-      acc.steady_iterations += step_costs.steady_iterations;
-      acc.steady_linear_iterations += step_costs.steady_linear_iterations;
-      acc.steady_seconds += step_costs.steady_seconds;
-    };
+      vec<double> xnew = std::move(xn->x);
+      const int iters = xn->iterations;
+      const double step_seconds = seconds_since(t_point);
+      // costs of this step, kept apart from those of landings emitted before xnew
+      const symmetric_hopf_curve_stats step_costs = std::exchange(acc, symmetric_hopf_curve_stats{});
+      auto add_step_costs = [&] {
+        acc.linear_iterations += step_costs.linear_iterations;
+        acc.steady_solves += step_costs.steady_solves;
+        acc.steady_iterations += step_costs.steady_iterations;
+        acc.steady_linear_iterations += step_costs.steady_linear_iterations;
+        acc.steady_seconds += step_costs.steady_seconds;
+      };
 
-    // ---- Bogdanov-Takens: omega reaches zero (or below what the corrector resolves) ----
-    const double omega_floor = xn->omega_floor;
-    if (xnew[iom] <= std::max(opt.omega_min, omega_floor)) {
-      std::vector<const vec<double>*> pts = {&x, &xnew};
-      if (x_prev.size()) pts.push_back(&x_prev);
-      double s1 = 0, sz = 0, szz = 0;
-      double sy[2] = {0, 0}, szy[2] = {0, 0};
-      for (const vec<double>* q : pts) {
-        const double z = (*q)[iom] * (*q)[iom];
-        s1 += 1, sz += z, szz += z * z;
-        for (int j = 0; j < 2; ++j) sy[j] += (*q)[imu + j], szy[j] += z * (*q)[imu + j];
-      }
-      const double det = s1 * szz - sz * sz;
-      for (int j = 0; j < 2; ++j) {
-        const double a = std::abs(det) > 1e-300 ? (szz * sy[j] - sz * szy[j]) / det : xnew[imu + j];
-        (j == 0 ? res.bogdanov_takens_mu : res.bogdanov_takens_nu) = a;
-      }
-      add_step_costs();
-      if (xnew[iom] > omega_floor)  // a Hopf point with a resolved frequency
-        emit(make_point(xnew, iters, attempts, ydist(xnew, x), step_seconds, false));
-      return finish(hopf_curve_stop::bogdanov_takens,
-                    internal::concat("omega -> 0: the Hopf curve ends at a Bogdanov-Takens point near nu = ",
-                                     res.bogdanov_takens_nu, ", mu = ", res.bogdanov_takens_mu, " (last omega ",
-                                     xnew[iom], ")"));
-    }
-
-    // ---- landings on targets and bounds crossed by this step, in curve order ----
-    std::vector<std::pair<double, landing>> crossed;
-    for (const auto& l : lands) {
-      const double a = x[imu + l.row] - l.value, b = xnew[imu + l.row] - l.value;
-      if (a * b < 0 || (b == 0 && a != 0)) crossed.push_back({a / (a - b), l});
-    }
-    std::sort(crossed.begin(), crossed.end(), [](const auto& u, const auto& v) { return u.first < v.first; });
-    for (const auto& [theta, l] : crossed) {
-      const auto t_land = clock::now();
-      const vec<double> x0 = x + theta * (xnew - x);
-      double c[3] = {0, 0, 0};
-      c[l.row] = 1;
-      joint_now = sopt.joint_equilibrium;
-      auto xl = correct(x0, s, c, l.value, sopt.iterate_distance * ds);
-      if (!xl && joint_now) {
-        joint_now = false;
-        xl = correct(x0, s, c, l.value, sopt.iterate_distance * ds);
-      }
-      if (xl && !(xl->x[iom] > xl->omega_floor)) {
-        last_failure = internal::concat("the landed point has omega = ", xl->x[iom], ", not above the resolved frequency ",
-                                        xl->omega_floor);
-        xl.reset();
-      }
-      if (xl) {
-        emit(make_point(xl->x, xl->iterations, 1, ydist(xl->x, x), seconds_since(t_land), true));
-      } else {
-        if (opt.verbose && opt.log)
-          *opt.log << lab << ": landing on " << (l.row ? "nu = " : "mu = ") << l.value << " failed: " << last_failure
-                   << std::endl;
-        if (!l.bound) res.missed_targets.push_back(l.value);
-      }
-      if (l.bound) {
-        if (!xl) {
-          add_step_costs();
+      // ---- Bogdanov-Takens: omega reaches zero (or below what the corrector resolves) ----
+      const double omega_floor = xn->omega_floor;
+      if (xnew[iom] <= std::max(opt.omega_min, omega_floor)) {
+        std::vector<const vec<double>*> pts = {&x, &xnew};
+        if (x_prev.size()) pts.push_back(&x_prev);
+        double s1 = 0, sz = 0, szz = 0;
+        double sy[2] = {0, 0}, szy[2] = {0, 0};
+        for (const vec<double>* q : pts) {
+          const double z = (*q)[iom] * (*q)[iom];
+          s1 += 1, sz += z, szz += z * z;
+          for (int j = 0; j < 2; ++j) sy[j] += (*q)[imu + j], szy[j] += z * (*q)[imu + j];
+        }
+        const double det = s1 * szz - sz * sz;
+        for (int j = 0; j < 2; ++j) {
+          const double a = std::abs(det) > 1e-300 ? (szz * sy[j] - sz * szy[j]) / det : xnew[imu + j];
+          (j == 0 ? res.bogdanov_takens_mu : res.bogdanov_takens_nu) = a;
+        }
+        add_step_costs();
+        if (xnew[iom] > omega_floor)  // a Hopf point with a resolved frequency
           emit(make_point(xnew, iters, attempts, ydist(xnew, x), step_seconds, false));
-        }
-        return finish(l.row ? hopf_curve_stop::nu_bounds : hopf_curve_stop::mu_bounds,
-                      internal::concat("reached ", l.row ? "nu = " : "mu = ", l.value,
-                                       xl ? "" : " (landing failed: the last point lies outside)"));
+        return finish(hopf_curve_stop::bogdanov_takens,
+                      internal::concat("omega -> 0: the Hopf curve ends at a Bogdanov-Takens point near nu = ",
+                                       res.bogdanov_takens_nu, ", mu = ", res.bogdanov_takens_mu, " (last omega ",
+                                       xnew[iom], ")"));
       }
+
+      // ---- landings on targets and bounds crossed by this step, in curve order ----
+      std::vector<std::pair<double, landing>> crossed;
+      for (const auto& l : lands) {
+        const double a = x[imu + l.row] - l.value, b = xnew[imu + l.row] - l.value;
+        if (a * b < 0 || (b == 0 && a != 0)) crossed.push_back({a / (a - b), l});
+      }
+      std::sort(crossed.begin(), crossed.end(), [](const auto& u, const auto& v) { return u.first < v.first; });
+      for (const auto& [theta, l] : crossed) {
+        const auto t_land = clock::now();
+        const vec<double> x0 = x + theta * (xnew - x);
+        double c[3] = {0, 0, 0};
+        c[l.row] = 1;
+        joint_now = sopt.joint_equilibrium;
+        auto xl = correct(x0, s, c, l.value, sopt.iterate_distance * ds);
+        if (!xl && joint_now) {
+          joint_now = false;
+          xl = correct(x0, s, c, l.value, sopt.iterate_distance * ds);
+        }
+        if (xl && !(xl->x[iom] > xl->omega_floor)) {
+          last_failure = internal::concat("the landed point has omega = ", xl->x[iom], ", not above the resolved frequency ",
+                                          xl->omega_floor);
+          xl.reset();
+        }
+        if (xl) {
+          emit(make_point(xl->x, xl->iterations, 1, ydist(xl->x, x), seconds_since(t_land), true));
+        } else {
+          if (opt.verbose && opt.log)
+            *opt.log << lab << ": landing on " << (l.row ? "nu = " : "mu = ") << l.value << " failed: " << last_failure
+                     << std::endl;
+          if (!l.bound) res.missed_targets.push_back(l.value);
+        }
+        if (l.bound) {
+          if (!xl) {
+            add_step_costs();
+            emit(make_point(xnew, iters, attempts, ydist(xnew, x), step_seconds, false));
+          }
+          return finish(l.row ? hopf_curve_stop::nu_bounds : hopf_curve_stop::mu_bounds,
+                        internal::concat("reached ", l.row ? "nu = " : "mu = ", l.value,
+                                         xl ? "" : " (landing failed: the last point lies outside)"));
+        }
+        if (res.points.size() >= size_t(opt.max_points)) return finish(hopf_curve_stop::max_points, "max_points reached");
+        if (stop_requested) return finish(hopf_curve_stop::requested, "stop requested by stop_after");
+      }
+
+      // ---- accept ----
+      const double len = ydist(xnew, x);
+      arclength += len;
+      add_step_costs();
+      emit(make_point(xnew, iters, attempts, len, step_seconds, false));
       if (res.points.size() >= size_t(opt.max_points)) return finish(hopf_curve_stop::max_points, "max_points reached");
       if (stop_requested) return finish(hopf_curve_stop::requested, "stop requested by stop_after");
+      s = refresh_s(xnew);
+      x_prev = std::move(x);
+      rescale_p(x_prev, s);
+      t = xnew - x_prev;
+      t /= std::sqrt(ydot(t, t));
+      x = std::move(xnew);
+      if (opt.detect_closed && arclength > 3 * len && ydist(x, x_first) < len)
+        return finish(hopf_curve_stop::closed_curve,
+                      internal::concat("the curve closed on its start after arclength ", arclength));
+      if (iters <= opt.fast_iterations) ds = std::min(opt.max_step, opt.growth * ds);
     }
-
-    // ---- accept ----
-    const double len = ydist(xnew, x);
-    arclength += len;
-    add_step_costs();
-    emit(make_point(xnew, iters, attempts, len, step_seconds, false));
-    if (res.points.size() >= size_t(opt.max_points)) return finish(hopf_curve_stop::max_points, "max_points reached");
-    if (stop_requested) return finish(hopf_curve_stop::requested, "stop requested by stop_after");
-    s = refresh_s(xnew);
-    x_prev = std::move(x);
-    rescale_p(x_prev, s);
-    t = xnew - x_prev;
-    t /= std::sqrt(ydot(t, t));
-    x = std::move(xnew);
-    if (opt.detect_closed && arclength > 3 * len && ydist(x, x_first) < len)
-      return finish(hopf_curve_stop::closed_curve,
-                    internal::concat("the curve closed on its start after arclength ", arclength));
-    if (iters <= opt.fast_iterations) ds = std::min(opt.max_step, opt.growth * ds);
-  }
   } catch (const error& e) {
     const hopf_curve_point& lp = res.points.back();  // the start at least
     const std::string where = internal::curve_failure_context(lab, res.points.size(), lp.nu, lp.mu, lp.omega);
