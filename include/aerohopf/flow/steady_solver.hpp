@@ -98,23 +98,11 @@ inline void check_steady_options(const steady_options& o, const char* who) {
           ": exact_switch_drop must lie in [0, 1] (got ", o.exact_switch_drop, ")");
 }
 
-/// The first cell whose density or pressure is not positive (or not finite); -1 if none.
-template <int Dim>
-long first_unphysical_cell(const euler_model<Dim>& m, const vec<double>& w) {
-  constexpr int nv = Dim + 2;
-  for (std::size_t c = 0; c < m.n_cells(); ++c) {
-    state<double, Dim> s;
-    for (int v = 0; v < nv; ++v) s[v] = w[static_cast<Eigen::Index>(c * nv + v)];
-    const auto q = to_primitive<double, Dim>(s);
-    if (!(q.rho > 0.0) || !(q.p > 0.0)) return static_cast<long>(c);
-  }
-  return -1;
-}
-
-/// true if every cell has positive density and pressure
+/// true if every cell has positive, finite density and pressure (euler_model::is_physical, the
+/// one physical-state test of the flow layer).
 template <int Dim>
 bool physical_state(const euler_model<Dim>& m, const vec<double>& w) {
-  return first_unphysical_cell<Dim>(m, w) < 0;
+  return m.is_physical(w);
 }
 
 namespace internal {
@@ -138,10 +126,7 @@ steady_report solve_steady(euler_model<Dim>& m, vec<double>& w, const steady_opt
   check_steady_options(opt, who);
   require_size(w.size(), m.size(), who, "state");
   require_finite(w, who, "state");
-  {
-    const long c = first_unphysical_cell<Dim>(m, w);
-    require(c < 0, who, ": initial state has non-positive density or pressure in cell ", c);
-  }
+  m.require_physical(w.data(), "solve_steady: initial state");
   const auto t0 = std::chrono::steady_clock::now();
   const auto n = static_cast<Eigen::Index>(m.n_cells());
   const double rootn = std::sqrt(static_cast<double>(w.size()));
@@ -232,8 +217,9 @@ steady_report solve_steady(euler_model<Dim>& m, vec<double>& w, const steady_opt
       wn = w + dw;
       if (const Eigen::Index i = internal::first_non_finite(dw); i >= 0) {
         rejected = aerohopf::internal::concat("update not finite (entry ", i, "; GMRES: ", lin.reason, ")");
-      } else if (const long c = first_unphysical_cell<Dim>(m, wn); c >= 0) {
-        rejected = aerohopf::internal::concat("non-positive density or pressure in cell ", c);
+      } else if (const auto d = m.first_nonphysical_cell(wn.data())) {
+        rejected = aerohopf::internal::concat("non-positive density or pressure in block ", d->block, " (state cell ",
+                                              d->global, ")");
       } else {
         rn = residual(static_cast<const vec<double>&>(wn));
         require_size(rn.size(), w.size(), who, "residual");
