@@ -403,3 +403,37 @@ TEST(newton, RejectsBadOptionsNamingThem) {
   }
   EXPECT_EQ(calls, 0);
 }
+
+// f(x) = sqrt(x) - 1/2 on x >= 0, the model refusing x < 0 (as the Euler residual refuses a
+// negative density). From x0 = 2 the full Newton step lands at x = -0.586: the line search must
+// halve past the refused point (to x = 0.707, ||f|| 0.34 < 0.91) and converge to the root 1/4;
+// without it the refusal is the failure, in the model's words.
+TEST(Newton, LineSearchHalvesPastATrialPointTheModelRefuses) {
+  auto residual = [](const vec<double>& x) {
+    if (x[0] < 0) throw input_error("model: negative density at x = " + std::to_string(x[0]));
+    vec<double> f(1);
+    f[0] = std::sqrt(x[0]) - 0.5;
+    return f;
+  };
+  auto step = [](const vec<double>& x, const vec<double>& f, int) {
+    vec<double> dx(1);
+    dx[0] = -f[0] * 2.0 * std::sqrt(x[0]);
+    return dx;
+  };
+  vec<double> x0(1);
+  x0[0] = 2.0;
+  newton_options o;
+  o.abs_tolerance = 1e-13;
+  o.line_search = true;
+  const newton_result r = newton_iterate(residual, step, x0, o, "sqrt");
+  ASSERT_TRUE(r.report.converged) << r.report.reason;
+  EXPECT_NEAR(r.x[0], 0.25, 1e-12);
+  EXPECT_EQ(x0[0], 2.0);
+
+  o.line_search = false;
+  o.throw_on_failure = false;
+  const newton_result f = newton_iterate(residual, step, x0, o, "sqrt");
+  EXPECT_FALSE(f.report.converged);
+  EXPECT_NE(f.report.reason.find("negative density"), std::string::npos) << f.report.reason;
+  EXPECT_EQ(f.x[0], 2.0);  // the last good iterate
+}

@@ -214,19 +214,40 @@ newton_result newton_iterate(ResidualFn&& residual, StepFn&& solve_step, vec<dou
                                       ", target ", target));
     vec<double> dx, xn, fnew;
     double dxn = NAN, psi = relaxing ? opt.relaxation : 1.0, fnn = NAN;
+    std::string refused;  // the model's refusal of the last trial point, if any
     try {
       dx = solve_step(x, f, k);
       dxn = internal::norm_or_nan(dx);
       if (dx.size() == x.size() && std::isfinite(dxn)) {
-        xn = x + psi * dx;
-        fnew = residual(xn);
-        fnn = internal::norm_or_nan(fnew);
+        // With the line search, a trial point the model refuses (input_error: e.g. negative
+        // density or pressure) is a step too long, halved like one with a non-finite residual;
+        // the model's words are kept for the failure message.
+        auto trial = [&] {
+          xn = x + psi * dx;
+          if (!opt.line_search) {
+            fnew = residual(xn);
+          } else {
+            try {
+              fnew = residual(xn);
+            } catch (const input_error& e) {
+              refused = e.what();
+              fnew.resize(0);
+            }
+          }
+          if (fnew.size() == 0) {
+            fnn = NAN;
+            return;
+          }
+          if (fnew.size() != x.size())
+            throw input_error(internal::concat(what, ": residual at the trial point of step ", k, " has ", fnew.size(),
+                                               " entries, the iterate ", x.size()));
+          fnn = internal::norm_or_nan(fnew);
+        };
+        trial();
         if (opt.line_search) {
           for (int h = 0; h < 10 && !(fnn < fn); ++h) {
             psi *= 0.5;
-            xn = x + psi * dx;
-            fnew = residual(xn);
-            fnn = internal::norm_or_nan(fnew);
+            trial();
           }
         }
       }
@@ -240,7 +261,7 @@ newton_result newton_iterate(ResidualFn&& residual, StepFn&& solve_step, vec<dou
     if (!std::isfinite(fnn))
       return fail(k, internal::concat("residual not finite at iterate ", k, " (the step from ", at(k - 1, fn),
                                       ", ||dx|| = ", psi * dxn, opt.line_search ? ", after the line search" : "",
-                                      ")"));
+                                      ")", refused.empty() ? "" : "; last trial point refused: ", refused));
     x = std::move(xn);
     f = std::move(fnew);
     fn = fnn;
