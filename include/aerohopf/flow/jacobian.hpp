@@ -5,7 +5,7 @@
 // Exact: each face flux F(w_{-2}, w_{-1}, w_{+1}, w_{+2}) depends on the 4 cells along its grid
 // line through MUSCL, so a cell row has 4 Dim + 1 blocks (9 in 2D, 13 in 3D). The 4 blocks
 // dF/dw_k are obtained by local forward-mode AD of the SAME templated face function that the
-// residual uses (dual<4 (Dim+2)>: one pass gives all stencil derivatives): exact to rounding
+// residual uses (jet<double, 4 (Dim+2)>: one pass gives all stencil derivatives): exact to rounding
 // and never out of sync with the residual.
 // Modified order: MUSCL dependence dropped, dF/dw_{-1} = dF/dw_l and dF/dw_{+1} = dF/dw_r at
 // the MUSCL states (2 Dim + 1 blocks). With order 1 both coincide with the exact Jacobian of
@@ -21,7 +21,7 @@
 
 #include "../linalg/block_sparse_matrix.hpp"
 #include "../scalar/taylor.hpp"
-#include "dual.hpp"
+#include "../scalar/jet.hpp"
 #include "euler_model.hpp"
 
 namespace aerohopf::flow {
@@ -172,8 +172,8 @@ void assemble_jacobian(const euler_model<Dim>& m, const vec<double>& w, jacobian
     };
     const int wall = m.wall_side(b, d, k);
     if (exact2 || wall != 0) {
-      // one dual pass: derivatives with respect to the 4 nv unknowns of the stencil
-      using D4 = dual<4 * nv>;
+      // one jet pass: derivatives with respect to the 4 nv unknowns of the stencil
+      using D4 = jet<double, 4 * nv>;
       const std::size_t sten[4] = {cm - s, cm, c0, c0 + s};
       std::array<primitive<D4, Dim>, 4> qs;
       for (int p = 0; p < 4; ++p) {
@@ -187,7 +187,7 @@ void assemble_jacobian(const euler_model<Dim>& m, const vec<double>& w, jacobian
       for (int p = 0; p < 4; ++p) {
         block dflux;
         for (int u = 0; u < nv; ++u)
-          for (int v = 0; v < nv; ++v) dflux(u, v) = fl[u].d[p * nv + v];
+          for (int v = 0; v < nv; ++v) dflux(u, v) = fl[u].derivative(p * nv + v);
         scatter(sten[p], dflux);
       }
     } else {
@@ -198,7 +198,7 @@ void assemble_jacobian(const euler_model<Dim>& m, const vec<double>& w, jacobian
         qr = muscl_right<double, Dim>(to_primitive<double, Dim>(pb[cm]), qr, to_primitive<double, Dim>(pb[c0 + s]), eps);
       }
       const auto wl = to_conservative<double, Dim>(ql), wr = to_conservative<double, Dim>(qr);
-      using D2 = dual<2 * nv>;
+      using D2 = jet<double, 2 * nv>;
       state<D2, Dim> wld, wrd;
       for (int u = 0; u < nv; ++u) {
         wld[u] = D2::variable(wl[u], u);
@@ -211,8 +211,8 @@ void assemble_jacobian(const euler_model<Dim>& m, const vec<double>& w, jacobian
       block dl, dr;
       for (int u = 0; u < nv; ++u)
         for (int v = 0; v < nv; ++v) {
-          dl(u, v) = fl[u].d[v];
-          dr(u, v) = fl[u].d[nv + v];
+          dl(u, v) = fl[u].derivative(v);
+          dr(u, v) = fl[u].derivative(nv + v);
         }
       scatter(cm, dl);
       scatter(c0, dr);
