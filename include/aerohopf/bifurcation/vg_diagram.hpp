@@ -5,8 +5,8 @@
 // Each mode k is one eigenvalue lambda_k(mu) of A(w0(mu), mu), traced over the listed
 // parameters by shift-invert inverse power (inverse_power.hpp), every step shifted at the
 // mode's previous eigenvalue and started from its previous eigenvector. Reported per point:
-//     damping   g = 2 Re(lambda) / |Im(lambda)|       (g ~ 2 zeta: the structural damping
-//                                                      that would hold the mode neutral, negated)
+//     damping   g = 2 Re(lambda) / |Im(lambda)|       (= -2 zeta / sqrt(1 - zeta^2) for damping
+//                                                      ratio zeta: g < 0 stable, as in the V-g method)
 //     frequency |Im(lambda)|, in the model's time unit (the aerofoil's is c / U_inf, so
 //               omega c / U_inf = 2 k with k the reduced frequency; omega / omega_alpha =
 //               frequency * Ubar / 2)
@@ -18,8 +18,9 @@
 // each mode takes the candidate whose TRACKED PART (the structural unknowns of an aeroelastic
 // system: vg_options::tracked_offset / tracked_size) has the largest normalised overlap
 //     |s_prev^H s| / (||s_prev|| ||s||)
-// with its previous one (greedy, largest overlap first). A mode left without a candidate gets
-// one more inverse power from the secant prediction 2 lambda_k(mu_{j-1}) - lambda_k(mu_{j-2}).
+// with its previous one (greedy, largest overlap first). A mode left without a candidate, or
+// whose overlap is below vg_options::min_overlap, gets one more inverse power from the secant
+// prediction 2 lambda_k(mu_{j-1}) - lambda_k(mu_{j-2}) and the assignment is redone.
 // Eigenpairs with (almost) no tracked part are no candidates (vg_options::min_tracked_share).
 // Where a mode is still without one, or its overlap is below vg_options::min_overlap, the step
 // is halved (the intermediate parameters are solved, equilibrium(mu) included, but not
