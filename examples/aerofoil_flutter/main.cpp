@@ -17,7 +17,14 @@
 //   --hopf-gram-schmidt once|twice   Gram-Schmidt passes in the GMRES of the Hopf Newton
 //                               corrections (default once: hopf_krylov_options)
 //   --start-gram-schmidt once|twice  ... of the inverse-power start (default once)
-//   --skip-spectra --skip-boundaries --skip-jump-check --skip-verify --skip-reduced   parts to leave out
+//   --skip-spectra --skip-boundaries --skip-vg --skip-jump-check --skip-verify --skip-reduced   parts to leave out
+//   --vg-mach M                 Mach number of the V-g / V-f diagrams (default 0.80)
+//   --vg-grid g                 their grid (default the first of --grids)
+//   --vg-solver lu|krylov|auto  linear algebra of the diagrams' inverse powers: sparse LU of A - sigma I,
+//                               or GMRES preconditioned by BILU(--fill) of the modified-order L - sigma I
+//                               (auto: LU up to the coarse grid)
+//   --vg-range a,b --vg-points n   Ubar from a Ubar* to b Ubar* in n values (default 0.5,1.4 and 40;
+//                               Ubar* from this run's boundary point at --vg-mach, else a Hopf solve)
 //   --verify-grid g             grid of the time-marching verification (default medium)
 //   --contact-smoothing d       contact-switch smoothing of the reduced-model part (default 0.05;
 //                               0 = exact Osher switch, whose residual is not C2 at the equilibrium)
@@ -51,6 +58,11 @@
 //   crossing_check.csv (case,grid,mach,ubar_star,omega_star,ubar,omega)   every imaginary-axis crossing at
 //                               the jumps and last points of the coarse/medium boundaries (Schur complement)
 //   boundary_<case>_<grid>.csv  mach,ubar,omega,newton_iterations,linear_iterations,hopf_seconds,steady_seconds
+//   vg_<case>_<grid>_M<mach>.csv  mode,parameter,damping_g,frequency,re,im: V-g / V-f diagram (parameter
+//                               Ubar; g = 2 Re/|Im lambda|; frequency |Im lambda| in 1/(c/U_inf);
+//                               mode 0 plunge, 1 pitch by in-vacuo frequency)
+//   vg_flutter_<case>_<grid>_M<mach>.csv  mode,parameter,frequency,hopf_parameter,hopf_frequency:
+//                               its zero crossings of g, against the Hopf point
 //   verification.csv, history_<case>_M<mach>_<factor>.csv       time marching at 0.97 / 1.03 Ubar*
 //   costs.csv                                                   cost ratios to the steady solve
 //   reduced_coefficients.csv, reduced_damping.csv, reduced_lco.csv   reduced model (heavy case)
@@ -63,6 +75,7 @@
 #include <aerohopf/bifurcation/hopf_curve.hpp>
 #include <aerohopf/bifurcation/hopf_curve_symmetric.hpp>
 #include <aerohopf/bifurcation/inverse_power.hpp>
+#include <aerohopf/bifurcation/vg_diagram.hpp>
 #include <aerohopf/flow/naca_cgrid.hpp>
 #include <aerohopf/flow/steady_solver.hpp>
 #include <aerohopf/io/csv.hpp>
@@ -112,6 +125,14 @@ struct options {
   int fill = 2;
   double contact_smoothing = 0.05;  // of the reduced model's discretisation (osher_flux.hpp)
   bool spectra = true, boundaries = true, jump_check = true, verify = true, reduced = true, quick = false;
+  bool vg = true;
+  double vg_mach = 0.80;  // transonic (shocks on both surfaces), as the reduced model
+  std::optional<grid_level> vg_grid;  // default: the first of grids
+  double vg_from = 0.5, vg_to = 1.4;  // Ubar range of the diagrams, in Ubar*
+  // 40 values: steps of 0.023 Ubar*, none of them Ubar* itself, so that the g = 0 crossing is a
+  // genuine interpolation (the cubic's error at this step: ~1e-4 relative, test_vg_diagram.cpp)
+  int vg_points = 40;
+  std::string vg_solver = "auto";  // lu | krylov | auto (LU up to the coarse grid)
   bool crossing_medium = false;  // --crossing-medium: the crossing check on the medium grid too (~1 s per LU)
   grid_level verify_grid = level_named("medium");
 };
@@ -921,6 +942,91 @@ std::map<std::string, boundary> boundaries_part(const options& o) {
 
 
 // ---------------------------------------------------------------------------------------------
+// Part 2a: V-g / V-f diagrams at one Mach number (bifurcation/vg_diagram.hpp): damping
+// g = 2 Re/|Im| and frequency of the plunge and pitch modes against Ubar, traced from the
+// in-vacuo modes at the lowest Ubar by shift-invert inverse power and tracked by the structural
+// part of the eigenvector; g = 0 from below is the flutter point, checked against the Hopf point.
+
+void vg_part(const options& o, const std::map<std::string, boundary>& all) {
+  const grid_level g = o.vg_grid ? *o.vg_grid : o.grids.front();
+  for (const auto& c : o.cases) {
+    std::cout << "\n=== V-g / V-f diagram: " << c.name << " case, " << g.name << " grid, M = " << fixed(o.vg_mach, 2)
+              << " ===\n";
+    try {
+      const auto t0 = clk::now();
+      const auto s = make_system(g, o.vg_mach, c.mu_s);
+      const auto st = steady(s);
+      // the Hopf point of this run's boundary at vg_mach, else one Hopf solve from the inverse-power start
+      std::optional<boundary_point> hp;
+      if (const auto it = all.find(c.name + "_" + g.name); it != all.end())
+        for (const auto& q : it->second)
+          if (std::abs(q.mach - o.vg_mach) < 1e-9) hp = q;
+      if (!hp) {
+        hopf_point guess = krylov_start(s, st.w, c.ubar_guess, c.omega_guess, o.fill);
+        guess.mu = c.ubar_guess;
+        hp = hopf_at(s, o.vg_mach, st, guess, o.fill, c.name + " " + g.name + " V-g Hopf point");
+      }
+      require(hp.has_value(), "no Hopf point at M = ", o.vg_mach, " to set the Ubar range");
+      std::vector<double> ubars;
+      for (int k = 0; k < o.vg_points; ++k)
+        ubars.push_back(hp->ubar * (o.vg_from + (o.vg_to - o.vg_from) * k / std::max(1, o.vg_points - 1)));
+      vg_options vo;
+      vo.tracked_offset = s.flow_size();  // the structural unknowns (h, h', alpha, alpha')
+      vo.tracked_size = aerofoil_system::n_structure;
+      vo.inverse_power.tolerance = 1e-10;
+      const auto starts = vg_mode_starts(s.structure().in_vacuo_matrix(ubars.front()));  // plunge, pitch
+      const auto equilibrium = [&](double) { return st.w; };  // symmetric section: one flow for every Ubar
+      vg_result r;
+      const bool lu = o.vg_solver == "lu" || (o.vg_solver == "auto" && g.stride >= 4);
+      if (lu) {  // sparse LU of A - sigma I
+        r = vg_diagram(s, equilibrium, ubars, starts, vo);
+      } else {  // GMRES on the exact A - sigma I, BILU(k) of the modified-order L - sigma I
+        vo.inverse_power.tolerance = 1e-9;  // inexact inverse iteration: GMRES below it (inverse_power.hpp)
+        double l_mu = NAN;  // the modified-order Jacobian of the last Ubar (the same for every shift there)
+        Eigen::SparseMatrix<double> l;
+        r = vg_diagram(s, equilibrium, ubars, starts, vo, [&](const vec<double>& w, double mu, cplx sigma) {
+          if (!(mu == l_mu)) {
+            l = lhs_jacobian(s, w, mu);
+            l_mu = mu;
+          }
+          krylov_solver_options ko;
+          ko.fill_level = o.fill;
+          ko.krylov.relative_tolerance = 1e-10;
+          ko.krylov.max_iterations = 2000;
+          ko.krylov.restart = start_restart;
+          ko.krylov.record_history = false;
+          krylov_solver<Eigen::SparseMatrix<cplx>, 4> solver(ko, "V-g inverse power, complex BILU-GMRES");
+          solver.precondition_with(shifted(l, sigma));
+          return solver;
+        });
+      }
+      const std::string tag = c.name + "_" + g.name + "_M" + fixed(o.vg_mach, 2);
+      csv_writer csv(o.out / ("vg_" + tag + ".csv"), "mode,parameter,damping_g,frequency,re,im");
+      for (const auto& p : r.points)
+        csv.row({static_cast<long long>(p.mode), p.mu, p.damping, p.frequency, p.lambda.real(), p.lambda.imag()});
+      csv_writer fc(o.out / ("vg_flutter_" + tag + ".csv"), "mode,parameter,frequency,hopf_parameter,hopf_frequency");
+      const char* names[] = {"plunge", "pitch"};
+      for (const auto& f : r.flutter) {
+        fc.row({static_cast<long long>(f.mode), f.mu, f.frequency, hp->ubar, hp->omega});
+        std::printf("  g = 0 (rising): mode %d (%s) at Ubar = %.6f, frequency %.6f; Hopf point Ubar* = %.6f, omega* = %.6f "
+                    "(%+.1e, %+.1e relative)\n",
+                    f.mode, f.mode < 2 ? names[f.mode] : "?", f.mu, f.frequency, hp->ubar, hp->omega, f.mu / hp->ubar - 1,
+                    f.frequency / hp->omega - 1);
+      }
+      if (r.flutter.empty()) std::printf("  no zero crossing of g in Ubar = %.4f .. %.4f\n", ubars.front(), ubars.back());
+      long iterations = 0;
+      for (const auto& p : r.points) iterations += p.iterations;
+      std::printf("  %d modes x %zu Ubar values (%s): %d inverse powers (%ld iterations in the accepted ones), %d halved "
+                  "steps, %ld GMRES iterations, %.1f s (with the steady solve)\n",
+                  r.modes, ubars.size(), lu ? "sparse LU" : "BILU-GMRES", r.inverse_powers, iterations, r.subdivisions,
+                  r.linear_iterations, seconds_since(t0));
+    } catch (const error& e) {
+      std::cout << "  V-g diagram failed: " << e.what() << "\n";
+    }
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
 // Part 2b: where a boundary jumps to another mode, is the new point the LOWEST flutter speed?
 // Natural continuation only knows the mode it follows; after its branch ends (or the tracer
 // passes a fold) it accepts the other mode's Hopf point it finds. On the very coarse grid (256
@@ -1384,6 +1490,27 @@ int main(int argc, char** argv) {
         o.spectra = false;
       } else if (a == "--skip-boundaries") {
         o.boundaries = false;
+      } else if (a == "--skip-vg") {
+        o.vg = false;
+      } else if (a == "--vg-mach") {
+        o.vg_mach = std::stod(next());
+        require(o.vg_mach > 0 && o.vg_mach < 1, "--vg-mach must be in (0, 1)");
+      } else if (a == "--vg-grid") {
+        o.vg_grid = level_named(next());
+      } else if (a == "--vg-range") {
+        const std::string v = next();
+        const auto comma = v.find(',');
+        require(comma != std::string::npos, "--vg-range takes a,b (fractions of Ubar*), not ", v);
+        o.vg_from = std::stod(v.substr(0, comma));
+        o.vg_to = std::stod(v.substr(comma + 1));
+        require(o.vg_from > 0 && o.vg_to > o.vg_from, "--vg-range: need 0 < a < b (got ", v, ")");
+      } else if (a == "--vg-solver") {
+        o.vg_solver = next();
+        require(o.vg_solver == "lu" || o.vg_solver == "krylov" || o.vg_solver == "auto",
+                "--vg-solver takes lu, krylov or auto, not ", o.vg_solver);
+      } else if (a == "--vg-points") {
+        o.vg_points = std::stoi(next());
+        require(o.vg_points >= 2, "--vg-points must be >= 2");
       } else if (a == "--skip-jump-check") {
         o.jump_check = false;
       } else if (a == "--skip-verify") {
@@ -1462,6 +1589,7 @@ int main(int argc, char** argv) {
     if (o.spectra) spectra_part(o);
     std::map<std::string, boundary> all;
     if (o.boundaries) all = boundaries_part(o);
+    if (o.vg) vg_part(o, all);
     if (o.jump_check) jump_check_part(o, all);
     if (o.jump_check && o.boundaries) crossing_check_part(o, all);
     std::vector<double> march_costs;

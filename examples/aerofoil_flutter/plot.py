@@ -5,6 +5,8 @@ Usage: /usr/bin/python3 plot.py [out_dir]   (default out/aerofoil_flutter)
 
 boundaries.png  Ubar*(M) for both cases and grids, with the time-marching points
                 (filled: decaying at 0.97 Ubar*, crosses: growing at 1.03 Ubar*)
+vg_<case>_<grid>_M<mach>.png   V-g / V-f diagram: damping g and frequency omega / omega_alpha of the
+                plunge and pitch modes against Ubar, the flutter point (g = 0, rising) marked
 spectra.png     very coarse light case M = 0.5: eigenvalues at Ubar* - 0.01, Ubar*, Ubar* + 0.01
 histories.png   pitch histories of the time-marching runs
 jump_check.png  very coarse grid: largest Re lambda of the whole spectrum against Ubar / Ubar*
@@ -80,6 +82,44 @@ def boundaries(out):
     save(fig, out, "boundaries.png")
 
 
+MODE_NAMES = {0: "plunge", 1: "pitch"}  # by in-vacuo frequency (w_R = 0.343 < 1)
+
+
+def vg(out):
+    for path in sorted(glob.glob(os.path.join(out, "vg_*_M*.csv"))):
+        name = os.path.basename(path)[:-4]
+        if name.startswith("vg_flutter_"):
+            continue
+        tag = name[3:]  # <case>_<grid>_M<mach>
+        rows = read(path)
+        if not rows:
+            continue
+        fpath = os.path.join(out, f"vg_flutter_{tag}.csv")
+        flutter = read(fpath) if os.path.exists(fpath) else []
+        fig, axes = plt.subplots(2, 1, figsize=(7, 8), sharex=True)
+        for mode in sorted({int(r["mode"]) for r in rows}):
+            sel = [r for r in rows if int(r["mode"]) == mode]
+            u = col(sel, "parameter")
+            label = f"mode {mode} ({MODE_NAMES.get(mode, '?')})"
+            axes[0].plot(u, col(sel, "damping_g"), "o-", ms=3, label=label)
+            # frequency is |Im lambda| in 1/(c/U_inf): omega/omega_alpha = frequency * Ubar / 2
+            axes[1].plot(u, [f * x / 2 for f, x in zip(col(sel, "frequency"), u)], "o-", ms=3, label=label)
+        for k, f in enumerate(flutter):
+            uf, ff = float(f["parameter"]), float(f["frequency"])
+            lab = f"flutter (g = 0): $\\bar U$ = {uf:.4f}" + (f", Hopf {float(f['hopf_parameter']):.4f}" if k == 0 else "")
+            axes[0].plot(uf, 0.0, "k*", ms=12, label=lab)
+            axes[1].plot(uf, ff * uf / 2, "k*", ms=12)
+            for ax in axes:
+                ax.axvline(uf, color="k", lw=0.6, ls="--")
+        axes[0].axhline(0, color="gray", lw=0.8)
+        case, rest = tag.split("_", 1)
+        grid, mach = rest.rsplit("_M", 1)
+        finish_axes(axes[0], "", "damping g = 2 Re $\\lambda$ / |Im $\\lambda$|",
+                    f"V-g / V-f: {case} case, {grid} grid, M = {mach}")
+        finish_axes(axes[1], "reduced speed $\\bar U = U / (\\omega_\\alpha b)$", "frequency $\\omega / \\omega_\\alpha$")
+        save(fig, out, f"vg_{tag}.png")
+
+
 def spectra(out):
     path = os.path.join(out, "spectra.csv")
     if not os.path.exists(path):
@@ -143,7 +183,8 @@ def reduced(out):
     if not os.path.exists(dpath):
         return
     d = read(dpath)
-    fig, axes = plt.subplots(1, 3, figsize=(16, 4.5))
+    e = read(epath) if os.path.exists(epath) else []  # the time-marching runs (not with --skip-verify)
+    fig, axes = plt.subplots(1, 3 if e else 2, figsize=(16 if e else 11, 4.5))
     ax = axes[0]
     ax.plot(col(d, "ubar"), col(d, "re_reduced"), "-", label="reduced model")
     ax.plot(col(d, "ubar"), col(d, "re_exact"), "o", mfc="none", label="exact eigenvalue (inverse power)")
@@ -153,19 +194,17 @@ def reduced(out):
     ax.axhline(0, color="gray", lw=0.8)
     finish_axes(ax, "$\\bar U$", "Re $\\lambda$ (growth rate)", "damping of the critical mode")
     # growth rate against amplitude at Ubar* (the lowest Ubar of the envelope runs)
-    ax = axes[1]
-    if os.path.exists(epath):
-        e = read(epath)
-        if e:
-            u0 = min(float(r["ubar"]) for r in e)
-            sel = sorted((r for r in e if abs(float(r["ubar"]) - u0) < 1e-12), key=lambda r: float(r["alpha_amplitude"]))
-            ax.plot(col(sel, "alpha_amplitude"), col(sel, "growth_march"), "x", label="time marching (envelopes)")
-            k = float(sel[-1]["growth_model"]) / float(sel[-1]["alpha_amplitude"]) ** 2  # Re(c1) / kappa^2
-            amax = 1.1 * float(sel[-1]["alpha_amplitude"])
-            a = [amax * i / 100 for i in range(101)]
-            ax.plot(a, [k * x * x for x in a], "-", label="reduced model Re(c1) (A/kappa)$^2$")
-    finish_axes(ax, "pitch amplitude A (rad)", "growth rate of A", "amplitude-dependent damping at $\\bar U^*$")
-    ax = axes[2]
+    if e:
+        ax = axes[1]
+        u0 = min(float(r["ubar"]) for r in e)
+        sel = sorted((r for r in e if abs(float(r["ubar"]) - u0) < 1e-12), key=lambda r: float(r["alpha_amplitude"]))
+        ax.plot(col(sel, "alpha_amplitude"), col(sel, "growth_march"), "x", label="time marching (envelopes)")
+        k = float(sel[-1]["growth_model"]) / float(sel[-1]["alpha_amplitude"]) ** 2  # Re(c1) / kappa^2
+        amax = 1.1 * float(sel[-1]["alpha_amplitude"])
+        a = [amax * i / 100 for i in range(101)]
+        ax.plot(a, [k * x * x for x in a], "-", label="reduced model Re(c1) (A/kappa)$^2$")
+        finish_axes(ax, "pitch amplitude A (rad)", "growth rate of A", "amplitude-dependent damping at $\\bar U^*$")
+    ax = axes[-1]
     if os.path.exists(lpath):
         lrows = read(lpath)
         ax.plot(col(lrows, "ubar"), col(lrows, "alpha_amplitude"), "-", label="reduced model")
@@ -180,6 +219,7 @@ def reduced(out):
 def main():
     out = sys.argv[1] if len(sys.argv) > 1 else "out/aerofoil_flutter"
     boundaries(out)
+    vg(out)
     spectra(out)
     histories(out)
     jump_check(out)
