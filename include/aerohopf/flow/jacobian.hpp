@@ -102,7 +102,6 @@ template <int Dim>
 void assemble_jacobian(const euler_model<Dim>& m, const vec<double>& w, jacobian_kind kind,
                        block_sparse_matrix<double, Dim + 2>& a) {
   constexpr int nv = Dim + 2;
-  using jet = taylor<double, 1>;
   using block = Eigen::Matrix<double, nv, nv>;
   require_size(w.size(), m.size(), "assemble_jacobian", "state");
   m.template require_physical<double>(w.data(), "assemble_jacobian");
@@ -113,8 +112,10 @@ void assemble_jacobian(const euler_model<Dim>& m, const vec<double>& w, jacobian
   std::vector<std::vector<state<double, Dim>>> padded;
   m.template fill_padded<double>(met, w.data(), padded);
 
-  // dg/dw_donor of every halo cell (identity across interfaces).
-  const auto jet_metrics = euler_model<Dim>::template convert_metrics<jet>(met);
+  // dg/dw_donor of every halo cell (identity across interfaces): one jet pass per donor, the nv
+  // directions being the donor's nv unknowns.
+  using halo_jet = jet<double, nv>;
+  const auto jet_metrics = euler_model<Dim>::template convert_metrics<halo_jet>(met);
   std::vector<block> dhalo(m.halos().size()), dhalo2(m.halos().size());
   for (std::size_t k = 0; k < m.halos().size(); ++k) {
     const auto& h = m.halos()[k];
@@ -124,20 +125,20 @@ void assemble_jacobian(const euler_model<Dim>& m, const vec<double>& w, jacobian
     }
     const double* src = w.data() + (m.cell_offset(h.donor_block) + h.donor) * nv;
     const double* src2 = w.data() + (m.cell_offset(h.donor_block) + h.donor2) * nv;
-    for (int v = 0; v < nv; ++v) {
-      state<jet, Dim> donor, donor2, c1, c2;
-      for (int u = 0; u < nv; ++u) {
-        donor[u] = jet::variable(src[u], u == v ? 1.0 : 0.0);
-        c2[u] = jet(src2[u]);
-        c1[u] = jet(src[u]);
-        donor2[u] = jet::variable(src2[u], u == v ? 1.0 : 0.0);
-      }
-      const auto g = m.template halo_state<jet>(h, donor, c2, jet_metrics);
-      for (int u = 0; u < nv; ++u) dhalo[k](u, v) = g[u][1];
-      if (h.donor2 != h.donor) {
-        const auto g2 = m.template halo_state<jet>(h, c1, donor2, jet_metrics);
-        for (int u = 0; u < nv; ++u) dhalo2[k](u, v) = g2[u][1];
-      }
+    state<halo_jet, Dim> donor, donor2, c1, c2;
+    for (int u = 0; u < nv; ++u) {
+      donor[u] = halo_jet::variable(src[u], u);
+      c2[u] = halo_jet(src2[u]);
+      c1[u] = halo_jet(src[u]);
+      donor2[u] = halo_jet::variable(src2[u], u);
+    }
+    const auto g = m.template halo_state<halo_jet>(h, donor, c2, jet_metrics);
+    for (int u = 0; u < nv; ++u)
+      for (int v = 0; v < nv; ++v) dhalo[k](u, v) = g[u].derivative(v);
+    if (h.donor2 != h.donor) {
+      const auto g2 = m.template halo_state<halo_jet>(h, c1, donor2, jet_metrics);
+      for (int u = 0; u < nv; ++u)
+        for (int v = 0; v < nv; ++v) dhalo2[k](u, v) = g2[u].derivative(v);
     }
   }
 
