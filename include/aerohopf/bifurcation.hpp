@@ -10,3 +10,4 @@
 #include "bifurcation/hopf_point.hpp"
 #include "bifurcation/inverse_power.hpp"
 #include "bifurcation/root_locus.hpp"
+#include "bifurcation/vg_diagram.hpp"

@@ -11,7 +11,7 @@ work=$2
 rm -rf "$work"
 mkdir -p "$work"
 common=(--case light --grids very_coarse,coarse --mach-min 0.75 --mach-max 0.95 --skip-spectra --skip-verify
-        --skip-reduced --skip-jump-check --verbose)
+        --skip-reduced --skip-jump-check --skip-vg --verbose)
 "$exe" "$work/with" "${common[@]}" --coarse-predictor auto --coarse-guided-restart on > "$work/with.log"
 "$exe" "$work/without" "${common[@]}" --coarse-predictor off --coarse-guided-restart off > "$work/without.log"
 used=$(grep -c "predictor ||F||" "$work/with.log" || true)
