@@ -12,8 +12,11 @@
 #include <random>
 #include <string>
 #include <vector>
+#include "support/error_messages.hpp"
 
 using namespace aerohopf;
+using aerohopf::test::contains;
+using aerohopf::test::input_error_of;
 using namespace aerohopf::flow;
 
 namespace {
@@ -188,18 +191,6 @@ euler_model<3> box_model_3d(index_d<3> cells) {
   return euler_model<3>(g, {.mach = 0.7, .alpha_rad = 0.05});
 }
 
-template <class Fn>
-std::string input_error_of(Fn&& fn) {
-  try {
-    fn();
-  } catch (const input_error& e) {
-    return e.what();
-  }
-  ADD_FAILURE() << "no input_error thrown";
-  return "";
-}
-
-bool contains(const std::string& s, const std::string& part) { return s.find(part) != std::string::npos; }
 
 }  // namespace
 

@@ -12,8 +12,11 @@
 #include <limits>
 #include <random>
 #include <string>
+#include "support/error_messages.hpp"
 
 using namespace aerohopf;
+using aerohopf::test::contains;
+using aerohopf::test::input_error_of;
 using namespace aerohopf::flow;
 
 namespace {
@@ -292,19 +295,6 @@ vec<T> converted(const vec<double>& w) {
   return r;
 }
 
-/// what() of the input_error that fn throws ("" and a test failure if it throws none).
-template <class Fn>
-std::string input_error_of(Fn&& fn) {
-  try {
-    fn();
-  } catch (const input_error& e) {
-    return e.what();
-  }
-  ADD_FAILURE() << "no input_error thrown";
-  return "";
-}
-
-bool contains(const std::string& s, const std::string& part) { return s.find(part) != std::string::npos; }
 
 }  // namespace
 

@@ -7,24 +7,13 @@
 
 #include <limits>
 #include <string>
+#include "support/error_messages.hpp"
 
 using namespace aerohopf;
+using aerohopf::test::contains;
 using cd = std::complex<double>;
 
 namespace {
-
-template <class Fn>
-std::string singular_error_of(Fn&& fn) {
-  try {
-    fn();
-  } catch (const singular_matrix_error& e) {
-    return e.what();
-  }
-  ADD_FAILURE() << "no singular_matrix_error thrown";
-  return "";
-}
-
-bool contains(const std::string& s, const std::string& part) { return s.find(part) != std::string::npos; }
 
 Eigen::SparseMatrix<double> sparse_of(const Eigen::MatrixXd& a) { return a.sparseView(); }
 
@@ -53,8 +42,8 @@ TEST(direct_solver, dense_solver_refuses_to_solve_after_a_failed_factorisation) 
   singular << 1.0, 2.0, 2.0, 4.0;
   const vec<double> b = vec<double>::Ones(2);
   direct_solver<Eigen::MatrixXd> s("flutter LU");
-  EXPECT_TRUE(contains(singular_error_of([&] { s.compute(singular); }), "flutter LU"));
-  EXPECT_TRUE(contains(singular_error_of([&] { (void)s.solve(b); }), "flutter LU"));
+  EXPECT_TRUE(contains(test::error_of<singular_matrix_error>([&] { s.compute(singular); }), "flutter LU"));
+  EXPECT_TRUE(contains(test::error_of<singular_matrix_error>([&] { (void)s.solve(b); }), "flutter LU"));
 
   Eigen::MatrixXd good(2, 2);
   good << 2.0, 1.0, 1.0, 3.0;
@@ -80,8 +69,8 @@ TEST(direct_solver, sparse_solver_refuses_to_solve_after_a_failed_factorisation)
   singular.col(2).setZero();
   const vec<double> b = vec<double>::Ones(4);
   direct_solver<Eigen::SparseMatrix<double>> s("sparse flutter LU");
-  EXPECT_TRUE(contains(singular_error_of([&] { s.compute(sparse_of(singular)); }), "sparse flutter LU"));
-  EXPECT_TRUE(contains(singular_error_of([&] { (void)s.solve(b); }), "sparse flutter LU"));
+  EXPECT_TRUE(contains(test::error_of<singular_matrix_error>([&] { s.compute(sparse_of(singular)); }), "sparse flutter LU"));
+  EXPECT_TRUE(contains(test::error_of<singular_matrix_error>([&] { (void)s.solve(b); }), "sparse flutter LU"));
   s.compute(sparse_of(good));
   EXPECT_LT((good * vec<double>(s.solve(b)) - b).norm(), 1e-14);
   EXPECT_THROW(s.compute(sparse_of(singular)), singular_matrix_error);

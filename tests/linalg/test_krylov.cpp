@@ -11,8 +11,11 @@
 #include <limits>
 #include <random>
 #include <string>
+#include "support/error_messages.hpp"
 
 using namespace aerohopf;
+using aerohopf::test::contains;
+using aerohopf::test::input_error_of;
 using cd = std::complex<double>;
 
 namespace {
@@ -369,23 +372,6 @@ TEST(Krylov, FailuresAreReported) {
 }
 
 // ---- hostile input: sizes, options and initial guesses are checked at the entry ---------------
-
-namespace {
-
-template <class Fn>
-std::string input_error_of(Fn&& fn) {
-  try {
-    fn();
-  } catch (const input_error& e) {
-    return e.what();
-  }
-  ADD_FAILURE() << "no input_error thrown";
-  return "";
-}
-
-bool contains(const std::string& s, const std::string& part) { return s.find(part) != std::string::npos; }
-
-}  // namespace
 
 // A dense operator smaller (or larger, or non-square) than the right-hand side: the old GMRES
 // reported convergence with relative residual 0 after reading and writing past the matrix.

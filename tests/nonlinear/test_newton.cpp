@@ -5,8 +5,10 @@
 #include <aerohopf/nonlinear.hpp>
 
 #include <gtest/gtest.h>
+#include "support/error_messages.hpp"
 
 using namespace aerohopf;
+using aerohopf::test::contains;
 
 namespace {
 /// f(w) = (w0^2 + w1^2 - 4 mu, w0 - w1): root (sqrt(2 mu), sqrt(2 mu)) for mu > 0.
@@ -204,7 +206,6 @@ struct faulty_reactor {
   }
 };
 
-bool contains(const std::string& s, const std::string& part) { return s.find(part) != std::string::npos; }
 
 newton_options reactor_options() {
   newton_options o;
