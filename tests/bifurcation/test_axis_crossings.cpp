@@ -15,6 +15,7 @@
 
 #include <iostream>
 #include <random>
+#include <string>
 
 using namespace aerohopf;
 
@@ -156,4 +157,31 @@ TEST(axis_crossings, aerofoil_lowest_crossing_is_the_hopf_point) {
             << r.factorisations << " factorisations\n";
   EXPECT_NEAR(ubar, h.point.mu, 1e-7);
   EXPECT_NEAR(lowest.omega, h.point.omega, 1e-7);
+}
+
+TEST(axis_crossings, refuses_non_finite_band_tolerances_and_matrix_entries) {
+  const toy t = make_toy();
+  axis_crossing_options o;
+  o.samples = 20;
+  EXPECT_NO_THROW(imaginary_axis_crossings(t.a0, t.b_ss, o));
+  // an infinite band end or tolerance used to pass the range checks (inf > omega_min, inf > 0)
+  axis_crossing_options bad = o;
+  bad.omega_max = INFINITY;
+  EXPECT_THROW(imaginary_axis_crossings(t.a0, t.b_ss, bad), input_error);
+  bad = o;
+  bad.real_tolerance = INFINITY;  // would accept every sign change of Im q, poles included
+  EXPECT_THROW(imaginary_axis_crossings(t.a0, t.b_ss, bad), input_error);
+  bad = o;
+  bad.omega_tolerance = std::nan("");
+  EXPECT_THROW(imaginary_axis_crossings(t.a0, t.b_ss, bad), input_error);
+  // a NaN in the flow block of both matrices: NaN - NaN is no dependence on q, it is a bad entry
+  Eigen::SparseMatrix<double> j1 = t.a0, j2 = t.a0;
+  j1.coeffRef(3, 3) = std::nan("");
+  j2.coeffRef(3, 3) = std::nan("");
+  try {
+    split_affine(j1, 0.5, j2, 1.0, 4);
+    ADD_FAILURE() << "no exception";
+  } catch (const input_error& e) {
+    EXPECT_NE(std::string(e.what()).find("j1(3, 3) is not finite"), std::string::npos) << e.what();
+  }
 }

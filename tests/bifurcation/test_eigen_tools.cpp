@@ -7,7 +7,10 @@
 #include <Eigen/Eigenvalues>
 #include <gtest/gtest.h>
 
+#include <initializer_list>
 #include <iostream>
+#include <limits>
+#include <string>
 
 using namespace aerohopf;
 
@@ -116,4 +119,87 @@ TEST(root_locus, TracksDenseEigenvalueAlongMu) {
   // it crosses the imaginary axis between 0.164 and 0.166 (the first Hopf point)
   EXPECT_LT(locus[7].lambda.real(), 0.0);
   EXPECT_GT(locus[8].lambda.real(), 0.0);
+}
+
+namespace {
+/// Runs f, expects input_error whose message contains every one of the given words.
+template <class F>
+void expect_input_error(F f, std::initializer_list<const char*> words) {
+  try {
+    f();
+    ADD_FAILURE() << "no exception";
+  } catch (const input_error& e) {
+    for (const char* w : words) EXPECT_NE(std::string(e.what()).find(w), std::string::npos) << e.what() << " / " << w;
+  } catch (const std::exception& e) {
+    ADD_FAILURE() << "not an input_error: " << e.what();
+  }
+}
+}  // namespace
+
+TEST(inverse_power, RefusesNonFiniteShiftStartMatrixAndBadOptions) {
+  // diag(1, 2, 3): the valid call converges to 2 from the shift 1.9
+  Eigen::MatrixXd a = Eigen::Vector3d(1.0, 2.0, 3.0).asDiagonal();
+  const Eigen::SparseMatrix<double> as = a.sparseView();
+  EXPECT_NEAR(std::abs(inverse_power(a, 1.9).lambda - 2.0), 0.0, 1e-12);
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  expect_input_error([&] { inverse_power(a, {nan, 0.0}); }, {"inverse power", "shift"});
+  expect_input_error([&] { inverse_power(as, {0.0, INFINITY}); }, {"inverse power", "shift"});
+  // a NaN or zero start was replaced by the default start without a word
+  vec<std::complex<double>> bad = vec<std::complex<double>>::Ones(3);
+  bad[1] = {nan, 0.0};
+  expect_input_error([&] { inverse_power(a, 1.9, {}, &bad); }, {"start vector", "entry 1"});
+  const vec<std::complex<double>> zero = vec<std::complex<double>>::Zero(3);
+  expect_input_error([&] { inverse_power(a, 1.9, {}, &zero); }, {"start vector", "zero"});
+  const vec<std::complex<double>> short_start = vec<std::complex<double>>::Ones(2);
+  expect_input_error([&] { inverse_power(a, 1.9, {}, &short_start); }, {"start vector", "has 2 entries, expected 3"});
+  inverse_power_options o;
+  o.max_iterations = 0;
+  expect_input_error([&] { inverse_power(a, 1.9, o); }, {"max_iterations", "0"});
+  o = {};
+  o.tolerance = nan;
+  expect_input_error([&] { inverse_power(a, 1.9, o); }, {"tolerance"});
+  o.tolerance = -1e-8;
+  expect_input_error([&] { inverse_power_adjoint(as, 1.9, o); }, {"adjoint inverse power", "tolerance"});
+  // a NaN entry of A, dense and sparse, named by position
+  Eigen::MatrixXd an = a;
+  an(2, 1) = nan;
+  expect_input_error([&] { inverse_power(an, 1.9); }, {"matrix entry (2, 1)"});
+  const Eigen::SparseMatrix<double> asn = an.sparseView();
+  expect_input_error([&] { inverse_power(asn, 1.9); }, {"matrix entry (2, 1)"});
+}
+
+TEST(cayley, RefusesNonSquareNonFiniteMatrixAndBadOptions) {
+  const tubular_reactor r(8);
+  const auto a = r.jacobian(r.rest_state(), 0.1);
+  cayley_options o;
+  o.wanted = 0;  // returned an empty list without a word
+  expect_input_error([&] { cayley_rightmost(a, o); }, {"cayley_rightmost", "wanted"});
+  o = {};
+  o.a2 = -INFINITY;
+  expect_input_error([&] { cayley_rightmost(a, o); }, {"cayley_rightmost", "a2"});
+  o = {};
+  o.tolerance = 0;
+  expect_input_error([&] { cayley_rightmost(a, o); }, {"cayley_rightmost", "tolerance"});
+  Eigen::MatrixXd d = Eigen::MatrixXd(a);
+  d(3, 4) = std::numeric_limits<double>::quiet_NaN();
+  expect_input_error([&] { cayley_rightmost(d); }, {"cayley_rightmost", "(3, 4)"});
+  const Eigen::MatrixXd rect = Eigen::MatrixXd::Identity(4, 5);
+  expect_input_error([&] { cayley_rightmost(rect); }, {"cayley_rightmost", "4x5"});
+}
+
+TEST(root_locus, RefusesNonFiniteShiftAndMuBeforeAnyEquilibriumSolve) {
+  const tubular_reactor r(8);
+  int solves = 0;
+  const std::function<vec<double>(double)> equilibrium = [&](double mu) {
+    ++solves;
+    return reactor_state(r, mu);
+  };
+  // a NaN mu further down the list used to be found only after the earlier points were computed
+  expect_input_error([&] { root_locus(r, equilibrium, {0.12, 0.13, std::nan("")}, {-1.0, 1.0}); }, {"root_locus", "mus[2]"});
+  EXPECT_EQ(solves, 0);
+  expect_input_error([&] { root_locus(r, equilibrium, {0.12}, {std::nan(""), 1.0}); }, {"root_locus", "shift0"});
+  inverse_power_options o;
+  o.max_iterations = 0;
+  expect_input_error([&] { root_locus(r, equilibrium, {0.12}, {-1.0, 1.0}, o); }, {"root_locus", "max_iterations"});
+  EXPECT_EQ(solves, 0);
 }

@@ -100,3 +100,33 @@ TEST(rigid_motion, free_stream_preserved_on_pitching_plunging_grid) {
   const auto r1 = wall_model.residual(wall_model.free_stream_vector());
   EXPECT_GT((r1 - r0).cwiseAbs().maxCoeff(), 1e-3);
 }
+
+TEST(rigid_motion, refuses_non_finite_pose_axis_and_inconsistent_rest_grid_before_writing) {
+  const auto rest = coarsen(naca_cgrid(), 8).points;
+  rigid_pose<double> q;
+  q.alpha = 0.1;
+  multiblock_points<double, 2> pts, spd;
+  rigid_grid_motion<double>(rest, q, ea, pts, &spd);  // valid
+  EXPECT_EQ(pts.blocks.size(), rest.blocks.size());
+  // a NaN pose used to give a NaN grid without a word; nothing is written before the check
+  multiblock_points<double, 2> out;
+  q.alpha = std::nan("");
+  EXPECT_THROW(rigid_grid_motion<double>(rest, q, ea, out, &spd), input_error);
+  EXPECT_TRUE(out.blocks.empty());
+  q.alpha = 0.1;
+  q.h_dot = INFINITY;
+  EXPECT_THROW(rigid_grid_motion<double>(rest, q, ea, out), input_error);
+  q.h_dot = 0;
+  EXPECT_THROW(rigid_grid_motion<double>(rest, q, {std::nan(""), 0.0}, out), input_error);
+  // a jet pose: its value is checked
+  using J = taylor<double, 1>;
+  rigid_pose<J> qj;
+  qj.alpha = J::variable(std::nan(""), 1.0);
+  multiblock_points<J, 2> outj;
+  EXPECT_THROW(rigid_grid_motion<J>(rest, qj, ea, outj), input_error);
+  // a rest block whose point list does not match its dimensions
+  auto broken = rest;
+  broken.blocks[0].x.pop_back();
+  EXPECT_THROW(rigid_grid_motion<double>(broken, q, ea, out), input_error);
+  EXPECT_TRUE(out.blocks.empty());
+}

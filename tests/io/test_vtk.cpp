@@ -5,6 +5,8 @@
 #include <aerohopf/flow/naca_cgrid.hpp>
 #include <aerohopf/io/vtk.hpp>
 
+#include <cmath>
+#include <cstdio>
 #include <fstream>
 #include <sstream>
 #include <string>
@@ -52,4 +54,23 @@ TEST(vtk, free_stream_field_round_trip) {
   double mach = 0.0;
   in >> mach;
   EXPECT_NEAR(mach, 0.7, 1e-12);
+}
+
+TEST(vtk, refuses_non_finite_or_wrongly_sized_state_before_opening_the_file) {
+  const auto g = coarsen(naca_cgrid(), 8);
+  euler_model<2> m(g, {.mach = 0.7, .alpha_rad = 0.1});
+  const std::string path = ::testing::TempDir() + "/refused_field.vtk";
+  std::remove(path.c_str());
+  vec<double> w = m.free_stream_vector();
+  w[4 * 7 + 2] = std::nan("");  // cell 7
+  try {
+    io::write_vtk<2>(path, m, w);
+    ADD_FAILURE() << "a NaN state was written";
+  } catch (const input_error& e) {
+    EXPECT_NE(std::string(e.what()).find("write_vtk: state entry 30"), std::string::npos) << e.what();
+  }
+  EXPECT_FALSE(std::ifstream(path).good()) << "the refused state left a file behind";
+  const vec<double> short_w = m.free_stream_vector().head(m.size() - 1);
+  EXPECT_THROW(io::write_vtk<2>(path, m, short_w), input_error);
+  EXPECT_FALSE(std::ifstream(path).good());
 }

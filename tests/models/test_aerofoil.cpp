@@ -298,3 +298,47 @@ TEST(aerofoil_system, contact_smoothing_makes_the_residual_smooth_at_the_symmetr
             << ", relative difference " << spread << " (no third derivative)\n";
   EXPECT_GT(spread, 0.5);
 }
+
+TEST(aerofoil_system, residual_and_loads_refuse_non_finite_and_wrongly_sized_states) {
+  const auto s = make_system(0.6);
+  const vec<double> ok = perturbed_state(s, 3);
+  EXPECT_TRUE(s.residual<double>(ok, 1.0).allFinite());  // valid
+  auto message = [](auto f) {
+    try {
+      f();
+    } catch (const input_error& e) {
+      return std::string(e.what());
+    } catch (const std::exception& e) {
+      return std::string("not an input_error: ") + e.what();
+    }
+    return std::string("no exception");
+  };
+  // a NaN pitch moves the grid to NaN: the refusal names the structural unknown
+  vec<double> w = ok;
+  w[s.flow_size() + 2] = std::nan("");
+  EXPECT_NE(message([&] { s.residual<double>(w, 1.0); }).find("aerofoil_system::residual: state entry "),
+            std::string::npos)
+      << message([&] { s.residual<double>(w, 1.0); });
+  EXPECT_NE(message([&] { s.residual<double>(w, 1.0); }).find("structural unknown 2"), std::string::npos);
+  w = ok;
+  w[4 * 5 + 1] = INFINITY;
+  EXPECT_NE(message([&] { s.residual<double>(w, 1.0); }).find("flow cell 5"), std::string::npos)
+      << message([&] { s.residual<double>(w, 1.0); });
+  // a jet state: its value part is checked
+  using J = taylor<double, 1>;
+  vec<J> wj(ok.size());
+  for (Eigen::Index i = 0; i < ok.size(); ++i) wj[i] = J::variable(ok[i], 0.0);
+  wj[s.flow_size()] = J::variable(std::nan(""), 1.0);
+  EXPECT_THROW(s.residual<J>(wj, J(1.0)), input_error);
+  EXPECT_THROW(s.residual<double>(ok, std::nan("")), input_error);
+  // Ubar = 0: K has 1/Ubar^2
+  EXPECT_THROW(s.residual<double>(ok, 0.0), input_error);
+  // pose and loads read w[flow_size() + k] of any vector
+  const vec<double> short_w = ok.head(ok.size() - 2);
+  EXPECT_THROW(s.load_coefficients<double>(short_w), input_error);
+  EXPECT_THROW(s.pose<double>(short_w), input_error);
+  // every Jacobian entry point names itself
+  EXPECT_NE(message([&] { s.approximate_block_jacobian(short_w, 1.0); }).find("aerofoil_system::approximate_jacobian"),
+            std::string::npos);
+  EXPECT_NE(message([&] { s.block_jacobians(short_w, 1.0); }).find("aerofoil_system::jacobian"), std::string::npos);
+}

@@ -6,6 +6,7 @@
 #include <Eigen/Eigenvalues>
 
 #include <algorithm>
+#include <cmath>
 #include <complex>
 #include <vector>
 
@@ -123,4 +124,24 @@ TEST(HopfNormalForm, RejectsBadInput) {
   EXPECT_THROW(hopf_normal_form(1.0, -1), input_error);
   const hopf_normal_form m;
   EXPECT_THROW(m.residual(vec<double>::Zero(3).eval(), 0.0), input_error);
+}
+
+TEST(HopfNormalForm, EveryEvaluationRefusesWrongSizeAndNonFiniteStates) {
+  const hopf_normal_form m;  // size 5
+  const vec<double> w0 = vec<double>::Zero(5), longer = vec<double>::Zero(6), shorter = vec<double>::Zero(4);
+  EXPECT_EQ(m.jacobian(w0, 0.0).rows(), 5);  // valid
+  // the products with T^{-1} used to ignore or read past the extra / missing entries
+  EXPECT_THROW(m.jacobian(longer, 0.0), input_error);
+  EXPECT_THROW(m.jacobian(shorter, 0.0), input_error);
+  EXPECT_THROW(m.d_mu(longer, 0.0), input_error);
+  EXPECT_THROW(m.jacobian_d_mu(shorter, 0.0), input_error);
+  EXPECT_THROW(m.jacobian_directional(w0, 0.0, longer), input_error);
+  EXPECT_THROW(m.jacobian_directional(longer, 0.0, w0), input_error);
+  EXPECT_THROW(m.coordinates(longer), input_error);
+  EXPECT_THROW(m.centre_coordinates(shorter), input_error);
+  vec<double> bad = w0;
+  bad[3] = std::nan("");
+  EXPECT_THROW(m.jacobian(bad, 0.0), input_error);
+  EXPECT_THROW(m.jacobian(w0, std::nan("")), input_error);
+  EXPECT_THROW(m.jacobian_directional(w0, 0.0, bad), input_error);
 }

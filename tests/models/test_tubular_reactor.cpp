@@ -7,6 +7,8 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 using namespace aerohopf;
 
 namespace {
@@ -87,4 +89,27 @@ TEST(tubular_reactor, RejectsBadInput) {
   tubular_reactor r(8);
   EXPECT_THROW(r.residual(vec<double>(vec<double>::Ones(5)), 0.1), input_error);
   EXPECT_THROW(r.jacobian(vec<double>::Ones(3), 0.1), input_error);
+}
+
+TEST(tubular_reactor, RefusesNonFiniteStatesParametersAndShortStatesEverywhere) {
+  const tubular_reactor r(8);
+  vec<double> w = r.rest_state();
+  EXPECT_EQ(r.jacobian(w, 0.1).rows(), 16);  // valid
+  w[5] = std::nan("");
+  // a NaN state or mu used to come back as a NaN matrix or vector without a word
+  EXPECT_THROW(r.jacobian(w, 0.1), input_error);
+  EXPECT_THROW(r.d_mu(w, 0.1), input_error);
+  EXPECT_THROW(r.jacobian_d_mu(w, 0.1), input_error);
+  const vec<double> ok = r.rest_state();
+  EXPECT_THROW(r.jacobian(ok, std::nan("")), input_error);
+  EXPECT_THROW(r.jacobian_directional(ok, 0.1, w), input_error);
+  EXPECT_THROW(r.jacobian_directional(ok, 0.1, vec<double>::Ones(3).eval()), input_error);
+  // outlet_theta read w[2N - 1] of any vector
+  EXPECT_THROW(r.outlet_theta(vec<double>(vec<double>::Ones(4))), input_error);
+  tubular_reactor_parameters p;
+  p.gamma = std::nan("");
+  EXPECT_THROW(tubular_reactor(8, reactor_inflow::second_order, p), input_error);
+  p = {};
+  p.pe_h = INFINITY;
+  EXPECT_THROW(tubular_reactor(8, reactor_inflow::second_order, p), input_error);
 }

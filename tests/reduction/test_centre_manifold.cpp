@@ -345,3 +345,31 @@ TEST(CentreManifold, RejectsBadInput) {
   EXPECT_THROW(model.integrate(C(0.1, 0), 0.01, 1.0, 0.0), input_error);
   EXPECT_THROW(model.component_amplitude(99, 0.01), input_error);
 }
+
+TEST(CentreManifold, RefusesNonFiniteAdjointStartAndInconsistentCoefficients) {
+  const hopf_normal_form m;
+  const hopf_point hp = m.exact_hopf_point();
+  // a NaN (or zero) adjoint start used to be replaced by a default start without a word
+  vec<C> bad = hp.p.conjugate();
+  bad[1] = C(std::nan(""), 0.0);
+  centre_manifold_options o;
+  o.adjoint_start = &bad;
+  EXPECT_THROW(reduce_to_centre_manifold(m, hp, taylor_products<>{}, o), input_error);
+  const vec<C> zero = vec<C>::Zero(m.size());
+  o.adjoint_start = &zero;
+  EXPECT_THROW(reduce_to_centre_manifold(m, hp, taylor_products<>{}, o), input_error);
+  o = {};
+  o.adjoint.max_iterations = 0;
+  EXPECT_THROW(reduce_to_centre_manifold(m, hp, taylor_products<>{}, o), input_error);
+  // coefficients whose vectors disagree in size: reconstruct() would add them entry by entry
+  const centre_manifold_coefficients c = reduce_to_centre_manifold(m, hp);
+  EXPECT_NO_THROW(centre_manifold_model{c});
+  for (int k = 0; k < 4; ++k) {
+    centre_manifold_coefficients d = c;
+    if (k == 0) d.k11.resize(2);
+    if (k == 1) d.k20.resize(m.size() + 1);
+    if (k == 2) d.p.resize(3);
+    if (k == 3) d.w0_mu.resize(1);
+    EXPECT_THROW(centre_manifold_model(d, parameter_dependence::moving_equilibrium), input_error) << k;
+  }
+}

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <complex>
+#include <string>
 
 #include "aerohopf/models/hopf_normal_form.hpp"
 #include "aerohopf/reduction/derivative_products.hpp"
@@ -187,4 +188,31 @@ TEST(DerivativeProducts, RejectsBadInput) {
   bad[2] = std::nan("");
   EXPECT_THROW(taylor_products<>{}.products(sys, w0, 0.0, bad), input_error);
   EXPECT_THROW(derivative_products(sys, bad, 0.0, taylor_products<>{}), input_error);
+}
+
+TEST(DerivativeProducts, RefusesDirectionsOfTheWrongSizeInEveryProduct) {
+  // The polarisation sums v +- u of vectors of different sizes used to read past the shorter
+  // one and return a vector without a word.
+  const exp_system sys;
+  const vec<double> w0 = vec<double>::Zero(5), v = vec<double>::Ones(5), u4 = vec<double>::Ones(4),
+                    u6 = vec<double>::Ones(6);
+  const derivative_products dp(sys, w0, 0.0, taylor_products<>{});
+  EXPECT_EQ(dp.B(v, v).size(), 5);  // the valid call
+  EXPECT_THROW(dp.B(v, u4), input_error);
+  EXPECT_THROW(dp.B(u6, v), input_error);
+  EXPECT_THROW(dp.C_vvu(v, u4), input_error);
+  EXPECT_THROW(dp.B(u6), input_error);
+  EXPECT_THROW(dp.C(u4), input_error);
+  const vec<C> p = v.cast<C>(), p4 = u4.cast<C>();
+  EXPECT_THROW(dp.B(p, p4), input_error);
+  EXPECT_THROW(dp.B_pp(p4), input_error);
+  EXPECT_THROW(dp.B_ppbar(p4), input_error);
+  EXPECT_THROW(dp.C_ppbar(p4), input_error);
+  try {
+    dp.B(v, u4);
+  } catch (const input_error& e) {
+    EXPECT_NE(std::string(e.what()).find("derivative_products::B(v, u): direction u has 4 entries, expected 5"),
+              std::string::npos)
+        << e.what();
+  }
 }

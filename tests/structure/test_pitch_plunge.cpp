@@ -113,3 +113,15 @@ TEST(pitch_plunge, rejects_bad_parameters) {
   EXPECT_THROW(pitch_plunge{p}, input_error);
   EXPECT_THROW(pitch_plunge{}.stiffness_d_ubar(0.0), input_error);
 }
+
+TEST(pitch_plunge, refuses_zero_or_non_finite_ubar_in_every_stiffness_entry_point) {
+  const pitch_plunge s;
+  EXPECT_TRUE(s.in_vacuo_matrix(2.0).allFinite());  // valid
+  // K has 1/Ubar^2: Ubar = 0 used to give an infinite matrix without a word
+  EXPECT_THROW(s.in_vacuo_matrix(0.0), input_error);
+  EXPECT_THROW(s.in_vacuo_matrix(std::nan("")), input_error);
+  EXPECT_THROW(s.stiffness_matrix<double>(0.0), input_error);
+  EXPECT_THROW(s.stiffness_matrix<double>(INFINITY), input_error);
+  const Eigen::Vector4d ws(0.01, 0.0, 0.02, 0.0);
+  EXPECT_THROW(s.rate<double>(ws, 0.1, 0.01, 0.0), input_error);
+}

@@ -26,6 +26,7 @@
 #include <algorithm>
 #include <cmath>
 #include <complex>
+#include <initializer_list>
 #include <numeric>
 #include <string>
 #include <vector>
@@ -199,6 +200,13 @@ inline affine_split split_affine(const Eigen::SparseMatrix<double>& j1, double q
   require(std::isfinite(q1) && std::isfinite(q2) && q1 != q2, context, ": need finite q1 != q2 (got ", q1, ", ", q2, ")");
   const Eigen::Index n = j1.rows();
   require(m >= 1 && m < n, context, ": trailing block size ", m, " for matrices of size ", n);
+  // Non-finite entries are refused here: NaN - NaN is not zero, so they would otherwise be
+  // reported as a dependence on q outside the trailing block.
+  for (const auto* j : {&j1, &j2})
+    for (int k = 0; k < j->outerSize(); ++k)
+      for (Eigen::SparseMatrix<double>::InnerIterator it(*j, k); it; ++it)
+        require(std::isfinite(it.value()), context, ": ", j == &j1 ? "j1" : "j2", "(", it.row(), ", ", it.col(),
+                ") is not finite (", it.value(), ")");
   const Eigen::SparseMatrix<double> d = j1 - j2;
   affine_split out;
   out.b_ss = Eigen::MatrixXd::Zero(m, m);
@@ -221,11 +229,13 @@ inline affine_split split_affine(const Eigen::SparseMatrix<double>& j1, double q
 inline axis_crossing_result imaginary_axis_crossings(const Eigen::SparseMatrix<double>& a0, const Eigen::MatrixXd& b_ss,
                                                      const axis_crossing_options& opt = {}) {
   const std::string& ctx = opt.context;
-  require(opt.omega_min > 0 && opt.omega_max > opt.omega_min && opt.samples >= 2, ctx,
+  require(std::isfinite(opt.omega_max) && opt.omega_min > 0 && opt.omega_max > opt.omega_min && opt.samples >= 2, ctx,
           ": need 0 < omega_min < omega_max and samples >= 2 (got ", opt.omega_min, ", ", opt.omega_max, ", ",
           opt.samples, ")");
-  require(opt.omega_tolerance > 0 && opt.real_tolerance > 0 && opt.max_refinements >= 1, ctx,
-          ": tolerances must be > 0 and max_refinements >= 1");
+  require(std::isfinite(opt.omega_tolerance) && opt.omega_tolerance > 0 && std::isfinite(opt.real_tolerance) &&
+              opt.real_tolerance > 0 && opt.max_refinements >= 1,
+          ctx, ": tolerances must be finite and > 0 and max_refinements >= 1 (got omega_tolerance ",
+          opt.omega_tolerance, ", real_tolerance ", opt.real_tolerance, ", max_refinements ", opt.max_refinements, ")");
   internal::axis_crossing_roots roots(a0, b_ss, ctx);
   axis_crossing_result res;
   res.rank = roots.rank();

@@ -19,6 +19,7 @@
 #include <Eigen/Eigenvalues>
 
 #include <algorithm>
+#include <cmath>
 #include <complex>
 #include <vector>
 
@@ -37,12 +38,32 @@ struct cayley_options {
 };
 
 /// Up to `wanted` rightmost eigenvalues of A (dominant |theta|, converged Ritz values only),
-/// sorted by decreasing real part.
+/// sorted by decreasing real part. A must be square and finite; options: finite a1 > a2,
+/// subspace >= 1, restarts >= 0, wanted >= 1, finite tolerance > 0 (input_error otherwise).
 template <class Matrix>
 std::vector<std::complex<double>> cayley_rightmost(const Matrix& a, const cayley_options& opt = {}) {
   using C = std::complex<double>;
   const Eigen::Index n = a.rows();
-  require(opt.a1 > opt.a2, "cayley_rightmost: needs a1 > a2");
+  const char* who = "cayley_rightmost";
+  require(a.rows() == a.cols(), who, ": matrix is ", a.rows(), "x", a.cols(), ", not square");
+  require(n >= 1, who, ": matrix is empty");
+  require(std::isfinite(opt.a1) && std::isfinite(opt.a2) && opt.a1 > opt.a2, who,
+          ": needs finite a1 > a2 (got a1 = ", opt.a1, ", a2 = ", opt.a2, ")");
+  require(opt.subspace >= 1, who, ": subspace must be >= 1 (got ", opt.subspace, ")");
+  require(opt.restarts >= 0, who, ": restarts must be >= 0 (got ", opt.restarts, ")");
+  require(opt.wanted >= 1, who, ": wanted must be >= 1 (got ", opt.wanted, ")");
+  require(std::isfinite(opt.tolerance) && opt.tolerance > 0, who, ": tolerance must be finite and > 0 (got ",
+          opt.tolerance, ")");
+  if constexpr (is_sparse_matrix_v<Matrix>) {
+    for (int k = 0; k < a.outerSize(); ++k)
+      for (typename Matrix::InnerIterator it(a, k); it; ++it)
+        require(std::isfinite(it.value()), who, ": matrix entry (", it.row(), ", ", it.col(), ") is not finite (",
+                it.value(), ")");
+  } else {
+    for (Eigen::Index j = 0; j < n; ++j)
+      for (Eigen::Index i = 0; i < n; ++i)
+        require(std::isfinite(a(i, j)), who, ": matrix entry (", i, ", ", j, ") is not finite (", a(i, j), ")");
+  }
   const int m = int(std::min<Eigen::Index>(opt.subspace, n));
   direct_solver<std::decay_t<decltype(shifted(a, opt.a1))>> lu("cayley: A - a1 I");
   lu.compute(shifted(a, opt.a1));

@@ -38,6 +38,8 @@
 
 namespace aerohopf {
 
+/// tolerance finite and > 0, max_iterations >= 1 (input_error otherwise); no convergence within
+/// max_iterations throws convergence_error with the last eigenvalue and residual.
 struct inverse_power_options {
   double tolerance = 1e-12;  ///< on ||A x - lambda x||_2 / max(1, |lambda|), ||x||_2 = 1 (see above)
   int max_iterations = 100;
@@ -77,9 +79,38 @@ template <class Matrix, class Solver>
 eigen_pair inverse_power_impl(const Matrix& a, std::complex<double> shift, const inverse_power_options& opt,
                               const vec<std::complex<double>>* start, const char* who, Solver& solver) {
   using C = std::complex<double>;
+  // Every input is checked before the (costly) factorisation: a NaN in the shift, the start or
+  // A would otherwise surface only as a "non-finite iterate", and a zero or NaN start used to be
+  // replaced silently by the default one.
   require(a.rows() == a.cols(), who, ": matrix is ", a.rows(), "x", a.cols(), ", not square");
-  require(!start || start->size() == a.rows(), who, ": start vector has ", start ? start->size() : 0,
-          " entries, matrix ", a.rows());
+  require(a.rows() >= 1, who, ": matrix is empty");
+  require(std::isfinite(shift.real()) && std::isfinite(shift.imag()), who, ": shift ", shift, " is not finite");
+  require(opt.max_iterations >= 1, who, ": max_iterations must be >= 1 (got ", opt.max_iterations, ")");
+  require(std::isfinite(opt.tolerance) && opt.tolerance > 0, who, ": tolerance must be finite and > 0 (got ",
+          opt.tolerance, ")");
+  if (start) {
+    require_size(start->size(), a.rows(), who, "start vector");
+    require_finite(*start, who, "start vector");
+    require(start->norm() > 0, who, ": start vector is zero");
+  }
+  double a_norm = 0;  // ||A||_inf, the scale of the attainable residual
+  {
+    vec<double> row_sums = vec<double>::Zero(a.rows());
+    if constexpr (is_sparse_matrix_v<Matrix>) {
+      for (int k = 0; k < a.outerSize(); ++k)
+        for (typename Matrix::InnerIterator it(a, k); it; ++it) {
+          require(std::isfinite(it.value()), who, ": matrix entry (", it.row(), ", ", it.col(), ") is not finite (",
+                  it.value(), ")");
+          row_sums[it.row()] += std::abs(it.value());
+        }
+    } else {
+      for (Eigen::Index j = 0; j < a.cols(); ++j)
+        for (Eigen::Index i = 0; i < a.rows(); ++i)
+          require(std::isfinite(a(i, j)), who, ": matrix entry (", i, ", ", j, ") is not finite (", a(i, j), ")");
+      row_sums = a.cwiseAbs().rowwise().sum();
+    }
+    a_norm = row_sums.maxCoeff();
+  }
   // A shift that is an eigenvalue to working precision (e.g. the exact i omega at a Hopf point)
   // makes A - sigma I singular; inverse power only needs it invertible, so nudge the shift.
   for (int attempt = 0;; ++attempt) {
@@ -92,20 +123,8 @@ eigen_pair inverse_power_impl(const Matrix& a, std::complex<double> shift, const
     }
   }
   const auto ac = a.template cast<C>();
-  double a_norm = 0;  // ||A||_inf, the scale of the attainable residual
-  {
-    vec<double> row_sums = vec<double>::Zero(a.rows());
-    if constexpr (is_sparse_matrix_v<Matrix>) {
-      for (int k = 0; k < a.outerSize(); ++k)
-        for (typename Matrix::InnerIterator it(a, k); it; ++it) row_sums[it.row()] += std::abs(it.value());
-    } else {
-      row_sums = a.cwiseAbs().rowwise().sum();
-    }
-    a_norm = row_sums.size() ? row_sums.maxCoeff() : 0.0;
-  }
 
   vec<C> x = start ? start->normalized() : default_start(a.rows());
-  if (!x.allFinite() || x.norm() == 0) x = default_start(a.rows());
   eigen_pair r;
   for (int t = 1; t <= opt.max_iterations; ++t) {
     const vec<C> y = solver.solve(x);

@@ -11,7 +11,9 @@
 #include <array>
 #include <cmath>
 
+#include "../error.hpp"
 #include "../flow/structured_grid.hpp"
+#include "../scalar/traits.hpp"
 
 namespace aerohopf::coupling {
 
@@ -42,6 +44,18 @@ template <class S>
 void rigid_grid_motion(const flow::multiblock_points<double, 2>& rest, const rigid_pose<S>& q,
                        const std::array<double, 2>& ea, flow::multiblock_points<S, 2>& points,
                        flow::multiblock_points<S, 2>* speeds = nullptr) {
+  // Checked before points / speeds are touched: a NaN pose or axis would give a NaN grid whose
+  // metrics and residual are NaN without a word, and a block whose point list does not match
+  // its dimensions would be moved only in part.
+  const char* who = "rigid_grid_motion";
+  require(std::isfinite(ea[0]) && std::isfinite(ea[1]), who, ": elastic axis (", ea[0], ", ", ea[1], ") is not finite");
+  require(std::isfinite(to_double(q.h)) && std::isfinite(to_double(q.h_dot)) && std::isfinite(to_double(q.alpha)) &&
+              std::isfinite(to_double(q.alpha_dot)),
+          who, ": pose is not finite (h ", to_double(q.h), ", h' ", to_double(q.h_dot), ", alpha ", to_double(q.alpha),
+          ", alpha' ", to_double(q.alpha_dot), ")");
+  for (std::size_t b = 0; b < rest.blocks.size(); ++b)
+    require_size(rest.blocks[b].x.size(), rest.blocks[b].n_points(), who,
+                 aerohopf::internal::concat("rest grid block ", b, " point list"));
   points.blocks.resize(rest.blocks.size());
   if (speeds) speeds->blocks.resize(rest.blocks.size());
   for (std::size_t b = 0; b < rest.blocks.size(); ++b) {

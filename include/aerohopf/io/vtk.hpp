@@ -16,7 +16,11 @@ template <int Dim>
 void write_vtk(const std::string& path, const flow::euler_model<Dim>& m, const vec<double>& w) {
   using namespace flow;
   constexpr int nv = Dim + 2;
-  require(w.size() == m.size(), "write_vtk: state has ", w.size(), " entries, model has ", m.size());
+  // Both checks come before the file is opened, so a refused state leaves no file behind. A
+  // non-finite state is refused (the entry index names the cell: entry / (Dim + 2)) rather than
+  // written as "nan", which the legacy-VTK reader does not parse.
+  require_size(w.size(), m.size(), "write_vtk", "state");
+  require_finite(w, "write_vtk", "state");
   std::ofstream out(path);
   require(out.good(), "write_vtk: cannot write '", path, "'");
   const auto& pts = m.grid().points;

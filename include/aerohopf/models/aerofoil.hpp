@@ -140,6 +140,7 @@ class aerofoil_system {
 
   template <class T>
   coupling::rigid_pose<T> pose(const vec<T>& w) const {
+    require_size(w.size(), size(), "aerofoil_system::pose", "state");
     return {w[nf_], w[nf_ + 1], w[nf_ + 2], w[nf_ + 3]};
   }
 
@@ -156,6 +157,7 @@ class aerofoil_system {
   /// (C_l, C_m about the moved elastic axis) of state w.
   template <class T>
   std::pair<T, T> load_coefficients(const vec<T>& w) const {
+    require_size(w.size(), size(), "aerofoil_system::load_coefficients", "state");
     flow::multiblock_points<T, 2> pts;
     const auto m = moved_metrics<T>(w, &pts);
     return loads<T>(m, pts, w);
@@ -163,7 +165,7 @@ class aerofoil_system {
 
   template <class T>
   vec<T> residual(const vec<T>& w, const T& mu) const {
-    require(w.size() == size(), "aerofoil_system::residual: state has ", w.size(), " entries, system has ", size());
+    check_entry(w, mu, "aerofoil_system::residual");
     flow::multiblock_points<T, 2> pts;
     const auto m = moved_metrics<T>(w, &pts);
     vec<T> r(size());
@@ -220,6 +222,26 @@ class aerofoil_system {
   }
 
  private:
+  /// Size and finiteness of a state and Ubar in any scalar (for a jet: its value parts), before
+  /// the grid is moved: a NaN pose would give NaN metrics and a NaN residual without a word.
+  template <class T>
+  void check_entry(const vec<T>& w, const T& mu, const char* who) const {
+    require_size(w.size(), size(), who, "state");
+    const double m = to_double(mu);
+    require(std::isfinite(m), who, ": parameter Ubar is not finite (", m, ")");
+    for (Eigen::Index i = 0; i < w.size(); ++i) {
+      const double x = to_double(w[i]);
+      if (!std::isfinite(x))
+        throw input_error(internal::concat(who, ": state entry ", i, " of ", w.size(), " is not finite (", x, ")",
+                                           i < nf_ ? internal::concat(", flow cell ", i / nv)
+                                                   : internal::concat(", structural unknown ", i - nf_)));
+    }
+  }
+  static const char* who_of(flow::jacobian_kind kind, const void* coupling_from) {
+    if (coupling_from) return "aerofoil_system::block_jacobians";
+    return kind == flow::jacobian_kind::exact ? "aerofoil_system::jacobian" : "aerofoil_system::approximate_jacobian";
+  }
+
   struct wall_face {
     int block, dir, sign;
     std::size_t face;
@@ -277,7 +299,7 @@ class aerofoil_system {
   /// blocks are copied from it instead of computed.
   block_sparse_matrix<double, nv> assemble_blocks(const vec<double>& w, double mu, flow::jacobian_kind kind,
                                                   const block_sparse_matrix<double, nv>* coupling_from = nullptr) const {
-    check_state(*this, w, mu, "aerofoil_system::jacobian");
+    check_state(*this, w, mu, who_of(kind, coupling_from));
     using sidx = block_sparse_matrix<double, nv>::storage_index;
     // A_ff on the moved grid.
     const vec<double> wf = w.head(nf_);

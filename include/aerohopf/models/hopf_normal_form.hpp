@@ -27,6 +27,7 @@
 #include <cmath>
 #include <complex>
 #include <cstdint>
+#include <string>
 
 #include "../bifurcation/hopf_point.hpp"
 #include "../error.hpp"
@@ -95,13 +96,19 @@ class hopf_normal_form {
   /// l1 = -s exactly (with <p, p> = 1, <q, p> = 1).
   double exact_l1() const { return -s_; }
   /// x1, x2 of the state w (the normal-form coordinates; |z|^2 = x1^2 + x2^2).
-  Eigen::Vector2d centre_coordinates(const vec<double>& w) const { return (t_inv_.topRows(2) * w).eval(); }
+  Eigen::Vector2d centre_coordinates(const vec<double>& w) const {
+    require_size(w.size(), size(), "hopf_normal_form::centre_coordinates", "state");
+    return (t_inv_.topRows(2) * w).eval();
+  }
   /// The manifold coordinates u = T^{-1} w.
-  vec<double> coordinates(const vec<double>& w) const { return t_inv_ * w; }
+  vec<double> coordinates(const vec<double>& w) const {
+    require_size(w.size(), size(), "hopf_normal_form::coordinates", "state");
+    return t_inv_ * w;
+  }
 
   template <class T>
   vec<T> residual(const vec<T>& w, const T& mu) const {
-    require(w.size() == size(), "hopf_normal_form::residual: state has ", w.size(), " entries, expected ", size());
+    require_size(w.size(), size(), "hopf_normal_form::residual", "state");
     const Eigen::Index n = size();
     const vec<T> u = multiply(t_inv_, w);
     const T& x1 = u[0];
@@ -119,6 +126,7 @@ class hopf_normal_form {
 
   /// Exact A = T Dg(u) T^{-1}.
   Eigen::MatrixXd jacobian(const vec<double>& w, double mu) const {
+    check(w, mu, "jacobian");
     const vec<double> u = t_inv_ * w;
     const double x1 = u[0], x2 = u[1];
     Eigen::MatrixXd dg = Eigen::MatrixXd::Zero(size(), size());
@@ -135,19 +143,24 @@ class hopf_normal_form {
   }
 
   /// f_mu = T (x1, x2, 0, ...).
-  vec<double> d_mu(const vec<double>& w, double) const {
+  vec<double> d_mu(const vec<double>& w, double mu) const {
+    check(w, mu, "d_mu");
     vec<double> gmu = vec<double>::Zero(size());
     gmu.head(2) = t_inv_.topRows(2) * w;
     return t_ * gmu;
   }
 
   /// A_mu = T diag(1, 1, 0, ...) T^{-1}.
-  Eigen::MatrixXd jacobian_d_mu(const vec<double>&, double) const {
+  Eigen::MatrixXd jacobian_d_mu(const vec<double>& w, double mu) const {
+    check(w, mu, "jacobian_d_mu");
     return t_.leftCols(2) * t_inv_.topRows(2);
   }
 
   /// A_w v = d/dt A(w + t v) at t = 0 (so (A_w v) x = B(v, x)), exact.
-  Eigen::MatrixXd jacobian_directional(const vec<double>& w, double, const vec<double>& v) const {
+  Eigen::MatrixXd jacobian_directional(const vec<double>& w, double mu, const vec<double>& v) const {
+    check(w, mu, "jacobian_directional");
+    require_size(v.size(), size(), "hopf_normal_form::jacobian_directional", "direction");
+    require_finite(v, "hopf_normal_form::jacobian_directional", "direction");
     const vec<double> u = t_inv_ * w, du = t_inv_ * v;
     const double x1 = u[0], x2 = u[1], v1 = du[0], v2 = du[1];
     Eigen::MatrixXd dg = Eigen::MatrixXd::Zero(size(), size());
@@ -163,6 +176,14 @@ class hopf_normal_form {
   }
 
  private:
+  /// The entry check of every double-valued evaluation: state of the system's size, finite,
+  /// finite mu (the products with T^{-1} would otherwise read past a short state).
+  void check(const vec<double>& w, double mu, const char* who) const {
+    const std::string where = std::string("hopf_normal_form::") + who;
+    require_size(w.size(), size(), where, "state");
+    require_finite(w, where, "state");
+    require(std::isfinite(mu), where, ": parameter mu is not finite (", mu, ")");
+  }
   /// M x in scalar T with the double entries of M converted exactly.
   template <class T>
   static vec<T> multiply(const Eigen::MatrixXd& m, const vec<T>& x) {

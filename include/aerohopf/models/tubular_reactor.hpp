@@ -24,6 +24,7 @@
 #include <Eigen/SparseCore>
 
 #include <cmath>
+#include <string>
 #include <vector>
 
 #include "../error.hpp"
@@ -51,7 +52,13 @@ class tubular_reactor {
                            tubular_reactor_parameters prm = {})
       : n_(cells), inflow_(inflow), prm_(prm), h_(1.0 / cells) {
     require(cells >= 3, "tubular_reactor: needs at least 3 cells, got ", cells);
-    require(prm.pe_m > 0 && prm.pe_h > 0, "tubular_reactor: Peclet numbers must be positive");
+    require(std::isfinite(prm.pe_m) && std::isfinite(prm.pe_h) && prm.pe_m > 0 && prm.pe_h > 0,
+            "tubular_reactor: Peclet numbers must be finite and positive (got Pe_m = ", prm.pe_m, ", Pe_h = ", prm.pe_h,
+            ")");
+    require(std::isfinite(prm.beta) && std::isfinite(prm.alpha) && std::isfinite(prm.gamma) &&
+                std::isfinite(prm.theta_bar),
+            "tubular_reactor: parameters must be finite (got beta = ", prm.beta, ", alpha = ", prm.alpha,
+            ", gamma = ", prm.gamma, ", theta_bar = ", prm.theta_bar, ")");
     // Halo at x = 0: u_{-1} = c0 u_0 + c1 u_1 + cc (same closure for y and Theta, Pe = Pe_m).
     const double hp = h_ * prm_.pe_m;
     switch (inflow_) {
@@ -69,14 +76,17 @@ class tubular_reactor {
   reactor_inflow inflow() const { return inflow_; }
   /// Theta at x = 1 (the outflow halo equals the last cell).
   template <class T>
-  T outlet_theta(const vec<T>& w) const { return w[2 * n_ - 1]; }
+  T outlet_theta(const vec<T>& w) const {
+    require_size(w.size(), size(), "tubular_reactor::outlet_theta", "state");
+    return w[2 * n_ - 1];
+  }
   /// The trivial equilibrium at mu = 0: y = Theta = 1 everywhere.
   vec<double> rest_state() const { return vec<double>::Ones(size()); }
 
   template <class T>
   vec<T> residual(const vec<T>& w, const T& mu) const {
     using std::exp;
-    require(w.size() == size(), "tubular_reactor::residual: state has ", w.size(), " entries, expected ", size());
+    require_size(w.size(), size(), "tubular_reactor::residual", "state");
     const T gam(prm_.gamma), alpha(prm_.alpha), beta(prm_.beta), tbar(prm_.theta_bar);
     const T dm = T(1.0) / (T(prm_.pe_m) * T(h_) * T(h_)), dh = T(1.0) / (T(prm_.pe_h) * T(h_) * T(h_));
     const T c = T(1.0) / (T(2.0) * T(h_));
@@ -98,7 +108,7 @@ class tubular_reactor {
   }
 
   jacobian_type jacobian(const vec<double>& w, double mu) const {
-    check(w, "jacobian");
+    check(w, mu, "jacobian");
     std::vector<Eigen::Triplet<double>> t;
     t.reserve(10 * n_);
     linear_part(t);
@@ -113,8 +123,8 @@ class tubular_reactor {
     return build(t);
   }
 
-  vec<double> d_mu(const vec<double>& w, double) const {
-    check(w, "d_mu");
+  vec<double> d_mu(const vec<double>& w, double mu) const {
+    check(w, mu, "d_mu");
     vec<double> f(size());
     for (int i = 0; i < n_; ++i) {
       const double g = w[2 * i] * std::exp(prm_.gamma - prm_.gamma / w[2 * i + 1]);
@@ -124,8 +134,8 @@ class tubular_reactor {
     return f;
   }
 
-  jacobian_type jacobian_d_mu(const vec<double>& w, double) const {
-    check(w, "jacobian_d_mu");
+  jacobian_type jacobian_d_mu(const vec<double>& w, double mu) const {
+    check(w, mu, "jacobian_d_mu");
     std::vector<Eigen::Triplet<double>> t;
     t.reserve(4 * n_);
     for (int i = 0; i < n_; ++i) {
@@ -142,8 +152,9 @@ class tubular_reactor {
   /// d/dt A(w + t v): only the reaction g = y exp(Gam - Gam/Th) has second derivatives,
   /// g_yTh = r Gam/Th^2, g_ThTh = y r (Gam^2/Th^4 - 2 Gam/Th^3).
   jacobian_type jacobian_directional(const vec<double>& w, double mu, const vec<double>& v) const {
-    check(w, "jacobian_directional");
-    require(v.size() == size(), "tubular_reactor::jacobian_directional: direction has wrong size");
+    check(w, mu, "jacobian_directional");
+    require_size(v.size(), size(), "tubular_reactor::jacobian_directional", "direction");
+    require_finite(v, "tubular_reactor::jacobian_directional", "direction");
     std::vector<Eigen::Triplet<double>> t;
     t.reserve(4 * n_);
     const double g = prm_.gamma;
@@ -161,8 +172,13 @@ class tubular_reactor {
   }
 
  private:
-  void check(const vec<double>& w, const char* who) const {
-    require(w.size() == size(), "tubular_reactor::", who, ": state has ", w.size(), " entries, expected ", size());
+  /// The entry check of every double-valued evaluation: state of the system's size, finite,
+  /// and a finite mu (a NaN would come back as a NaN matrix or vector without a word).
+  void check(const vec<double>& w, double mu, const char* who) const {
+    const std::string where = std::string("tubular_reactor::") + who;
+    require_size(w.size(), size(), where, "state");
+    require_finite(w, where, "state");
+    require(std::isfinite(mu), where, ": parameter mu is not finite (", mu, ")");
   }
   jacobian_type build(const std::vector<Eigen::Triplet<double>>& t) const {
     jacobian_type a(size(), size());

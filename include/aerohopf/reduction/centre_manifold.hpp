@@ -128,8 +128,15 @@ centre_manifold_coefficients reduce_to_centre_manifold(const S& s, const hopf_po
   require(hp.p.size() == s.size(), who, ": eigenvector p has ", hp.p.size(), " entries, system has ", s.size());
   require(hp.p.allFinite(), who, ": eigenvector p has non-finite entries");
   require(hp.p.norm() > 0, who, ": eigenvector p is zero");
-  require(!opt.adjoint_start || opt.adjoint_start->size() == s.size(), who, ": adjoint start vector has ",
-          opt.adjoint_start ? opt.adjoint_start->size() : 0, " entries, system has ", s.size());
+  if (opt.adjoint_start) {
+    require_size(opt.adjoint_start->size(), s.size(), who, "adjoint start vector");
+    require_finite(*opt.adjoint_start, who, "adjoint start vector");
+    require(opt.adjoint_start->norm() > 0, who, ": adjoint start vector is zero");
+  }
+  require(opt.adjoint.max_iterations >= 1, who, ": adjoint inverse power max_iterations must be >= 1 (got ",
+          opt.adjoint.max_iterations, ")");
+  require(std::isfinite(opt.adjoint.tolerance) && opt.adjoint.tolerance > 0, who,
+          ": adjoint inverse power tolerance must be finite and > 0 (got ", opt.adjoint.tolerance, ")");
 
   centre_manifold_coefficients r;
   r.w0 = hp.w;
@@ -252,7 +259,15 @@ class centre_manifold_model {
   explicit centre_manifold_model(centre_manifold_coefficients c,
                                  parameter_dependence dependence = parameter_dependence::spec)
       : c_(std::move(c)), dependence_(dependence) {
-    require(c_.omega > 0 && c_.p.size() > 0, "centre_manifold_model: coefficients are empty");
+    const char* who = "centre_manifold_model";
+    require(std::isfinite(c_.omega) && c_.omega > 0 && c_.p.size() > 0, who, ": coefficients are empty");
+    // reconstruct() adds w0, p, k20, k11 (and w0_mu for the moving-equilibrium dependence)
+    // entry by entry: they must all have the state's size.
+    const Eigen::Index n = c_.w0.size();
+    require_size(c_.p.size(), n, who, "eigenvector p");
+    require_size(c_.k20.size(), n, who, "k20");
+    require_size(c_.k11.size(), n, who, "k11");
+    if (dependence_ == parameter_dependence::moving_equilibrium) require_size(c_.w0_mu.size(), n, who, "w0_mu");
   }
 
   const centre_manifold_coefficients& coefficients() const { return c_; }

@@ -178,22 +178,29 @@ class derivative_products {
   int third_evaluations() const { return n_third_; }
 
   // ---- real directions ----
+  // Every direction must have the system's size (input_error otherwise): the polarisation sums
+  // v +- u of vectors of different sizes would read past the shorter one. Non-finite entries
+  // are refused by the provider (check_direction).
   // Every direction handed to the provider is scaled to unit 2-norm first (B(v, v) =
   // |v|^2 B(v^, v^), ...), so a finite-difference step h always means the same thing, however
   // large or small the vectors of the reduction are (k11, w0_mu can be O(1e3) near a fold).
   vec<double> B(const vec<double>& v) const {
+    require_size(v.size(), s_.size(), "derivative_products::B", "direction v");
     const double nv = v.norm();
     if (nv == 0) return vec<double>::Zero(v.size());
     ++n_second_;
     return (nv * nv) * provider_.second(s_, w0_, mu_, vec<double>(v / nv));
   }
   vec<double> B(const vec<double>& v, const vec<double>& u) const {
+    require_size(v.size(), s_.size(), "derivative_products::B(v, u)", "direction v");
+    require_size(u.size(), s_.size(), "derivative_products::B(v, u)", "direction u");
     const double nv = v.norm(), nu = u.norm();
     if (nv == 0 || nu == 0) return vec<double>::Zero(v.size());
     const vec<double> vh = v / nv, uh = u / nu;
     return (0.25 * nv * nu) * (B(vec<double>(vh + uh)) - B(vec<double>(vh - uh)));
   }
   vec<double> C(const vec<double>& v) const {
+    require_size(v.size(), s_.size(), "derivative_products::C", "direction v");
     const double nv = v.norm();
     if (nv == 0) return vec<double>::Zero(v.size());
     ++n_third_;
@@ -201,6 +208,8 @@ class derivative_products {
   }
   /// C(v, v, u).
   vec<double> C_vvu(const vec<double>& v, const vec<double>& u) const {
+    require_size(v.size(), s_.size(), "derivative_products::C_vvu", "direction v");
+    require_size(u.size(), s_.size(), "derivative_products::C_vvu", "direction u");
     const double nv = v.norm(), nu = u.norm();
     if (nv == 0 || nu == 0) return vec<double>::Zero(v.size());
     const vec<double> vh = v / nv, uh = u / nu;
@@ -210,6 +219,8 @@ class derivative_products {
   // ---- complex directions (B, C are real forms extended bilinearly, no conjugation) ----
   /// B(p, k); real parts skip the products that vanish (B(a, d) = 0 for real k, ...).
   cvec B(const cvec& p, const cvec& k) const {
+    require_size(p.size(), s_.size(), "derivative_products::B(p, k)", "direction p");
+    require_size(k.size(), s_.size(), "derivative_products::B(p, k)", "direction k");
     const vec<double> a = p.real(), b = p.imag(), c = k.real(), d = k.imag();
     const bool p_real = b.isZero(0.0), k_real = d.isZero(0.0);
     const vec<double> zero = vec<double>::Zero(a.size());
@@ -220,6 +231,7 @@ class derivative_products {
   }
   /// B(p, p) = B(a, a) - B(b, b) + 2 i B(a, b).
   cvec B_pp(const cvec& p) const {
+    require_size(p.size(), s_.size(), "derivative_products::B_pp", "direction p");
     const vec<double> a = p.real(), b = p.imag();
     cvec r(a.size());
     r.real() = B(a) - B(b);
@@ -228,11 +240,13 @@ class derivative_products {
   }
   /// B(p, conj p) = B(a, a) + B(b, b) (real).
   vec<double> B_ppbar(const cvec& p) const {
+    require_size(p.size(), s_.size(), "derivative_products::B_ppbar", "direction p");
     const vec<double> a = p.real(), b = p.imag();
     return B(a) + B(b);
   }
   /// C(p, p, conj p) = C(a,a,a) + C(a,b,b) + i [C(a,a,b) + C(b,b,b)].
   cvec C_ppbar(const cvec& p) const {
+    require_size(p.size(), s_.size(), "derivative_products::C_ppbar", "direction p");
     const vec<double> a = p.real(), b = p.imag();
     const vec<double> caaa = C(a), cbbb = C(b), cplus = C((a + b).eval()), cminus = C((a - b).eval());
     const vec<double> caab = (cplus - cminus - 2.0 * cbbb) / 6.0;

@@ -18,6 +18,7 @@
 #include <numbers>
 
 #include "../error.hpp"
+#include "../scalar/traits.hpp"
 
 namespace aerohopf::structure {
 
@@ -60,9 +61,11 @@ class pitch_plunge {
   }
   const matrix4& mass_inverse() const { return m_inv_; }
 
-  /// K(Ubar) of spec 05.
+  /// K(Ubar) of spec 05; Ubar (its value, for a jet) must be finite and non-zero (input_error).
   template <class T>
   Eigen::Matrix<T, 4, 4> stiffness_matrix(const T& ubar) const {
+    const double u = to_double(ubar);
+    require(std::isfinite(u) && u != 0, "pitch_plunge::stiffness_matrix: Ubar = ", u, " must be finite and non-zero");
     Eigen::Matrix<T, 4, 4> k;
     for (int i = 0; i < 4; ++i)
       for (int j = 0; j < 4; ++j) k(i, j) = T(0.0);
@@ -115,7 +118,12 @@ class pitch_plunge {
 
   /// In-vacuo state matrix -M^{-1} K(Ubar) (the structural block of the coupled Jacobian
   /// apart from the aerodynamic stiffness and damping).
-  matrix4 in_vacuo_matrix(double ubar) const { return -m_inv_ * stiffness_matrix<double>(ubar); }
+  /// Ubar must be finite and non-zero (input_error): K has 1/Ubar^2.
+  matrix4 in_vacuo_matrix(double ubar) const {
+    require(std::isfinite(ubar) && ubar != 0, "pitch_plunge::in_vacuo_matrix: Ubar = ", ubar,
+            " must be finite and non-zero");
+    return -m_inv_ * stiffness_matrix<double>(ubar);
+  }
 
  private:
   pitch_plunge_parameters p_;
