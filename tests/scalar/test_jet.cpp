@@ -120,12 +120,14 @@ TYPED_TEST(JetTyped, ProductQuotientAndMixedConstants) {
   s *= s;  // x^2: derivative 2 x dx
   EXPECT_TRUE(s.value() == T(0.25) && s.derivative(1) == T(2.0));
   J r = x;
-  r /= r;  // identically 1
+  const J& r_alias = r;  // the aliased operand through a reference (clang flags a literal r /= r)
+  r /= r_alias;          // identically 1
   EXPECT_TRUE(r.value() == T(1.0) && r.derivative(0) == T(0.0) && r.derivative(1) == T(0.0));
   J u = x;
   u += u;
   EXPECT_TRUE(u.value() == T(1.0) && u.derivative(1) == T(4.0));
-  u -= u;
+  const J& u_alias = u;
+  u -= u_alias;
   EXPECT_TRUE(u.value() == T(0.0) && u.derivative(1) == T(0.0));
   const J n = -x;
   EXPECT_TRUE(n.value() == T(-0.5) && n.derivative(1) == T(-2.0) && (+x).derivative(1) == T(2.0));
