@@ -9,6 +9,7 @@
 #include <aerohopf/flow/naca_cgrid.hpp>
 #include <aerohopf/flow/steady_solver.hpp>
 #include <aerohopf/models/aerofoil.hpp>
+#include <aerohopf/models/aerofoil_family.hpp>
 
 #include <chrono>
 #include <cmath>
@@ -67,6 +68,13 @@ inline aerofoil_system make_system(const grid_level& g, double mach, double mu_s
   return aerofoil_system(aerohopf::flow::euler_model<2>(aerohopf::flow::coarsen(fine_grid(), g.stride),
                                                          {.mach = mach, .alpha_rad = 0.0}, fo),
                          aerohopf::structure::pitch_plunge(p));
+}
+
+/// The family of the boundary driver (flutter_boundary.hpp): levels are grid strides.
+inline aerohopf::models::aerofoil_family family_of(const structural_case& c, double alpha_rad = 0.0) {
+  aerohopf::structure::pitch_plunge_parameters p;
+  p.mu_s = c.mu_s;
+  return aerohopf::models::aerofoil_family(fine_grid(), p, {}, alpha_rad);
 }
 
 inline std::string fixed(double x, int digits) {

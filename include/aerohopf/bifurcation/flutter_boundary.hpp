@@ -1,0 +1,979 @@
+#pragma once
+// The flutter boundary mu*(M): the Hopf point of a family of aeroelastic systems at each listed
+// Mach number (spec 02, 05), by natural continuation in M with a mode test, step control,
+// grid sequencing from a coarser level, jumps to another mode where a branch ends, and the
+// hand-over to the Hopf-curve tracer where natural continuation cannot follow a steep stretch.
+//
+// The family (concept flutter_family) is what a user's model supplies: the system at a grid
+// level and Mach number, its equilibrium (the unit of cost: "a steady solve"), prolongation of
+// an eigenvector from a coarser level, and the structural part of an eigenvector (the mode
+// test). Everything else is here, once, for the aerofoil as for a wing.
+//
+// Natural continuation: each point starts from the previous one (mu, omega and the eigenvector
+// by secant extrapolation over the last two points of the branch, the eigenvector then refined
+// by inverse iteration: hopf_krylov_options::start_iterations), solved by solve_hopf_krylov. A
+// point is accepted if the structural part of its eigenvector continues the previous one
+// (|cos| >= same_mode_cosine); a failed or other-mode point is retried from half the Mach step
+// down to 1/min_step_divisor, and the step doubles again after a success. On a finer level, a
+// listed Mach number whose start from the previous point fails is restarted from the coarser
+// boundary's point (grid sequencing: what the original work did by hand on the heavy case's
+// steep branches), and the coarser boundary's increments predict mu, omega and, where the
+// secant one is far off, the eigenvector. Where even the smallest step finds only the other
+// mode, the branch has ended and the boundary JUMPS to that mode; where nothing converges,
+// the fixed-equilibrium Hopf-curve tracer (trace_symmetric_hopf_curve) takes over up to the
+// next listed Mach number it lands on.
+//
+// Cost accounting: a listed Mach number's equilibrium from scratch is the unit; every other
+// second (rejected attempts, intermediate Mach numbers' flows, arclength stretches) is charged
+// to the next accepted point's hopf_seconds, so the points' hopf_seconds add up to the whole
+// work beyond one steady solve per point. flutter_boundary_costs is a pure function of them.
+//
+// Check: every jump and the last point are tested by imaginary_axis_crossings (the parameter
+// enters the structural block as q(mu) B, the family's stiffness_factor): PASS iff the lowest
+// crossing above min_crossing_fraction mu* is the boundary point itself.
+#include <Eigen/Core>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <complex>
+#include <concepts>
+#include <cstdarg>
+#include <cstdio>
+#include <deque>
+#include <iostream>
+#include <map>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "../error.hpp"
+#include "../linalg/krylov_solver.hpp"
+#include "axis_crossings.hpp"
+#include "equilibrium_krylov.hpp"
+#include "hopf.hpp"
+#include "hopf_bordered.hpp"
+#include "hopf_curve_symmetric.hpp"
+#include "inverse_power.hpp"
+
+namespace aerohopf {
+
+/// A family of aeroelastic systems over grid levels and Mach numbers, what
+/// trace_flutter_boundary needs of a user's model:
+/// - `system_type`, `block_size` (the unknowns' block size of the Krylov path);
+/// - `system(level, mach)`: the system on that level at that Mach number;
+/// - `level_name(level)`: for labels;
+/// - `equilibrium(s, mu)`: the equilibrium of s at mu from scratch (a steady solve; may throw
+///   convergence_error);
+/// - `prolong(fine, coarse, p)`: an eigenvector of `coarse` as one of `fine` (grid sequencing);
+/// - `refines(coarse_level, fine_level)`: whether prolong works between the two levels;
+/// - `structure_part(p)`: the structural unknowns of an eigenvector (the mode test);
+/// - `stiffness_factor(mu)`: q(mu) with A(mu) = A0 + q(mu) B, B in the structural block, and
+///   its inverse `parameter_of_factor(q)` > 0 (the crossing check; the aerofoil: q = 1/Ubar^2).
+template <class F>
+concept flutter_family = requires(const F& f, const typename F::system_type& s, int level, double mach,
+                                  const vec<std::complex<double>>& p) {
+  { F::block_size } -> std::convertible_to<int>;
+  { f.system(level, mach) } -> std::convertible_to<typename F::system_type>;
+  { f.level_name(level) } -> std::convertible_to<std::string>;
+  { f.equilibrium(s, mach) } -> std::convertible_to<vec<double>>;
+  { f.prolong(s, s, p) } -> std::convertible_to<vec<std::complex<double>>>;
+  { f.refines(level, level) } -> std::convertible_to<bool>;
+  { f.structure_part(p) } -> std::convertible_to<vec<std::complex<double>>>;
+  { f.stiffness_factor(mach) } -> std::convertible_to<double>;
+  { f.parameter_of_factor(mach) } -> std::convertible_to<double>;
+};
+
+enum class coarse_predictor { off, values, full, automatic };
+
+struct flutter_boundary_options {
+  /// Start of the first point (inverse power with shift i start_omega at start_mu).
+  double start_mu = 1, start_omega = 1;
+  /// Newton criterion ||F|| <= tolerance of the boundary points. 1e-7: Ubar* then changes by
+  /// < 1e-9 relative in a further iteration on the light medium NACA 0012 boundary, far below the
+  /// grid error; it fixes Ubar* only to ~2e-5 on the heavy one (mu enters only the stiffness).
+  double tolerance = 1e-7;
+  /// BILU(k) of the Hopf preconditioner and of the inverse-power start (2: heavy medium mean
+  /// Hopf / steady 0.89 vs 0.99 with BILU(1), measured).
+  int fill_level = 2;
+  /// Newton per point: 2-4 iterations from a refined continuation start; abandoned after
+  /// max_iterations, when ||F|| more than doubles after the first step (max_contraction), or
+  /// when the first step raises it 100x (divergence_factor; failures rose 125-1812x, converging
+  /// starts at most 33x on the NACA 0012 boundaries).
+  int max_iterations = 12;
+  double max_contraction = 2.0, divergence_factor = 100.0;
+  hopf_krylov_options krylov = [] {
+    hopf_krylov_options k;
+    // mu enters A only through the stiffness, so A0 + dmu A_mu0 stays accurate over a step
+    k.reuse_window = 2e-2;
+    k.start_iterations = 1;
+    k.start_tolerance = 1e-2;
+    k.start_residual_threshold = 10.0;  // subsonic continued guesses (||F|| 3-7) go straight to Newton
+    return k;
+  }();
+  /// GMRES restart of the inverse-power start (50: light medium 5.0-5.8 s vs 6.9-7.3 s with 80).
+  int start_restart = 50;
+  double same_mode_cosine = 0.9;  ///< mode test on the structural parts (one branch: 0.957-0.9991)
+  int min_step_divisor = 8;       ///< natural continuation gives up at 1/8 of a listed step
+  bool jump_search_bottom = true;    ///< other mode at the full step: try the smallest step next
+  bool coarse_restart = true;        ///< grid-sequenced restart where the start from the previous point fails
+  bool coarse_guided_restart = true; ///< ... first, where the coarser boundary changes mode within 1/4 step
+  coarse_predictor predictor = coarse_predictor::automatic;
+  /// mu enters the system only through mu^2 (the aerofoil's 1/Ubar^2): -mu* is the same point.
+  bool parameter_even = false;
+  /// Hand-over to the fixed-equilibrium Hopf-curve tracer (its step metric and bounds are the
+  /// model's: set curve.mu_scale, nu_scale, omega_scale, mu_min, mu_max, symmetric.fill_level...).
+  bool handover = true;
+  hopf_curve_options curve;
+  symmetric_hopf_curve_options symmetric;
+  double fold_tolerance = 0.005;   ///< the traced curve turning back in M by more: stop
+  double retrace_distance = 0.1;   ///< in the tracer's metric: a point this close to the old trail is a retrace
+  int handover_max_points = 200;
+  /// The crossing check of every jump and the last point (imaginary_axis_crossings).
+  bool check_crossings = true;
+  double crossing_omega_min = 0.05, crossing_omega_factor = 6.0, crossing_min_fraction = 0.2;
+  double crossing_mu_tolerance = 1e-5, crossing_omega_tolerance = 1e-4;
+  bool verbose = false;           ///< a line per Newton iteration
+  std::ostream* log = &std::cout;  ///< a line per point and attempt (nullptr: silent)
+  std::string label = "boundary";
+};
+
+struct flutter_boundary_point {
+  double mach = 0, mu = 0, omega = 0;
+  int newton_iterations = 0;
+  long linear_iterations = 0;
+  double hopf_seconds = 0, steady_seconds = 0;
+  hopf_point point;  ///< with the equilibrium at this Mach number
+  /// false for the points of an arclength stretch: their steady_seconds is the unit of cost
+  /// (the steady solve where the stretch starts), not a steady solve at their Mach number
+  bool own_steady = true;
+  double cosine = NAN;  ///< structural cosine to the previous point (NAN for the first)
+  bool jump = false;    ///< starts a new branch (another mode)
+};
+
+/// One attempt of natural continuation (accepted or not) or an arclength stretch.
+struct flutter_attempt {
+  double mach = 0;
+  std::string kind;     ///< "continued", "coarse restart", "first", "arclength"
+  std::string outcome;  ///< "accepted", "other mode", "failed: ..."
+  double seconds = 0;
+};
+
+struct crossing_check_record {
+  double mach = 0, mu = 0, omega = 0;
+  std::string what;  ///< "jump" or "last point"
+  double lowest_mu = NAN, lowest_omega = NAN;
+  std::size_t crossings = 0;
+  bool pass = false;
+  std::vector<std::pair<double, double>> all;  ///< (mu, omega) of every crossing with q > 0
+};
+
+struct flutter_boundary {
+  std::string label;
+  int level = 0;
+  std::vector<flutter_boundary_point> points;
+  std::vector<flutter_attempt> attempts;
+  bool complete = false;     ///< every listed Mach number reached
+  std::string stop_reason;   ///< why not, if not complete
+  std::vector<crossing_check_record> checks;
+  bool checks_passed() const {
+    return std::all_of(checks.begin(), checks.end(), [](const crossing_check_record& c) { return c.pass; });
+  }
+};
+
+/// The cost of a boundary per unit steady solve (pure function of its points).
+struct flutter_boundary_costs {
+  double hopf_per_steady = NAN;         ///< over the continued points (all but the first)
+  double hopf_per_steady_listed = NAN;  ///< all work beyond one steady solve per listed Mach number
+  std::size_t continued = 0, listed = 0;
+  double work_seconds = 0;  ///< every second of the boundary (Hopf work and steady solves)
+};
+
+namespace internal {
+
+inline double flutter_seconds_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+inline bool flutter_listed(const std::vector<double>& machs, double m) {
+  return std::any_of(machs.begin(), machs.end(), [&](double l) { return std::abs(l - m) < 1e-9; });
+}
+
+inline std::string flutter_fixed(double x, int digits) {
+  char b[64];
+  std::snprintf(b, sizeof b, "%.*f", digits, x);
+  return b;
+}
+
+/// printf to opt.log (nothing if it is null)
+#if defined(__GNUC__)
+__attribute__((format(printf, 2, 3)))
+#endif
+inline void flutter_say(std::ostream* log, const char* fmt, ...) {
+  if (!log) return;
+  char buf[2048];
+  va_list ap;
+  va_start(ap, fmt);
+  std::vsnprintf(buf, sizeof buf, fmt, ap);
+  va_end(ap);
+  *log << buf << std::flush;
+}
+
+inline void check_flutter_boundary_options(const flutter_boundary_options& o, const std::vector<double>& machs,
+                                           const std::string& where) {
+  require(!machs.empty(), where, ": no Mach numbers");
+  for (std::size_t k = 0; k < machs.size(); ++k) {
+    require(std::isfinite(machs[k]) && machs[k] > 0, where, ": Mach number ", k, " is ", machs[k]);
+    require(k == 0 || machs[k] > machs[k - 1] + 1e-9, where, ": the Mach numbers must increase (", machs[k - 1],
+            " then ", machs[k], ")");
+  }
+  require(std::isfinite(o.start_mu) && o.start_mu != 0, where, ": start_mu must be finite and non-zero (got ",
+          o.start_mu, ")");
+  require(std::isfinite(o.start_omega) && o.start_omega > 0, where, ": start_omega must be finite and > 0 (got ",
+          o.start_omega, ")");
+  require(o.tolerance > 0 && std::isfinite(o.tolerance), where, ": tolerance must be > 0 (got ", o.tolerance, ")");
+  require(o.fill_level >= 0, where, ": fill_level must be >= 0 (got ", o.fill_level, ")");
+  require(o.max_iterations >= 1, where, ": max_iterations must be >= 1 (got ", o.max_iterations, ")");
+  require(o.start_restart >= 1, where, ": start_restart must be >= 1 (got ", o.start_restart, ")");
+  require(o.same_mode_cosine > 0 && o.same_mode_cosine < 1, where, ": same_mode_cosine must lie in (0, 1) (got ",
+          o.same_mode_cosine, ")");
+  require(o.min_step_divisor >= 1, where, ": min_step_divisor must be >= 1 (got ", o.min_step_divisor, ")");
+  check_hopf_krylov_options(o.krylov, where);
+}
+
+}  // namespace internal
+
+/// |p0^H p1| / (|p0| |p1|) of the structural parts: the mode test. The flow part is no test:
+/// shock motion rotates it (full cosine 0.16-0.45 along one NACA 0012 branch).
+template <flutter_family F>
+double structural_cosine(const F& family, const vec<std::complex<double>>& p0, const vec<std::complex<double>>& p1) {
+  const vec<std::complex<double>> s0 = family.structure_part(p0), s1 = family.structure_part(p1);
+  require(s0.size() == s1.size() && s0.size() > 0, "structural_cosine: structural parts of sizes ", s0.size(), " and ",
+          s1.size());
+  return std::abs(s0.dot(s1)) / (s0.norm() * s1.norm());
+}
+
+/// Inverse-power start of a Hopf Newton iteration at (w, mu) with shift i omega (spec 02): GMRES
+/// on the exact A - i omega I preconditioned by the complex BILU(k) of the preconditioning
+/// L - i omega I; no sparse LU. GMRES to 1e-9 per solve: inexact inverse iteration stagnates
+/// near the solve tolerance (inverse_power.hpp). The returned guess has mu and omega of the
+/// eigenvalue found.
+template <int B, dynamical_system S>
+hopf_point hopf_start_krylov(const S& s, const vec<double>& w, double mu, double omega, int fill, int restart = 50,
+                             std::ostream* log = nullptr) {
+  using cplx = std::complex<double>;
+  krylov_solver_options ko;
+  ko.fill_level = fill;
+  ko.krylov.relative_tolerance = 1e-9;
+  ko.krylov.max_iterations = 2000;
+  ko.krylov.restart = restart;
+  ko.krylov.record_history = false;
+  ko.krylov.reorthogonalize = false;
+  krylov_solver<Eigen::SparseMatrix<cplx>, B> solver(ko, "inverse power, complex BILU-GMRES");
+  solver.precondition_with(shifted(lhs_jacobian(s, w, mu), cplx(0.0, omega)));
+  inverse_power_options ipo;
+  ipo.tolerance = 1e-8;  // a start for Newton, which converges the pair exactly
+  const auto t0 = std::chrono::steady_clock::now();
+  const eigen_pair ep = inverse_power(s.jacobian(w, mu), cplx(0.0, omega), ipo, nullptr, solver);
+  internal::flutter_say(log,
+                        "    inverse power (BILU(%d)-GMRES): lambda = %+.6f %+.6fi, %d iterations, %ld GMRES iterations, "
+                        "%.2f s\n",
+                        fill, ep.lambda.real(), ep.lambda.imag(), ep.iterations, ep.linear_iterations,
+                        internal::flutter_seconds_since(t0));
+  return internal::hopf_point_from(w, mu, ep);
+}
+
+namespace internal {
+
+/// The state of one trace_flutter_boundary call (its lambdas made members).
+template <flutter_family F>
+class flutter_boundary_tracer {
+ public:
+  using S = typename F::system_type;
+  using cplx = std::complex<double>;
+  using clk = std::chrono::steady_clock;
+  static constexpr int B = F::block_size;
+
+  flutter_boundary_tracer(const F& family, int level, const std::vector<double>& machs, const flutter_boundary* coarser,
+                          const flutter_boundary_options& opt)
+      : f_(family), level_(level), machs_(machs), coarser_(coarser), o_(opt), log_(opt.log) {
+    b_.label = opt.label;
+    b_.level = level;
+  }
+
+  flutter_boundary run();
+
+ private:
+  struct solved_flow {
+    double mach;
+    vec<double> w;
+    double seconds = 0;
+    bool charged = false;  ///< its seconds were added to rejected_ (an attempt there was rejected)
+    /// ... and a written point has taken them since: booked as lost work for good
+    bool settled = false;
+  };
+
+  const F& f_;
+  int level_;
+  const std::vector<double>& machs_;
+  const flutter_boundary* coarser_;
+  const flutter_boundary_options& o_;
+  std::ostream* log_;
+  flutter_boundary b_;
+  std::vector<flutter_boundary_point>& pts_ = b_.points;
+  std::size_t branch_start_ = 0;
+  double rejected_ = 0;
+  std::deque<solved_flow> flows_;  // references stay valid as it grows
+  std::map<double, std::optional<flutter_boundary_point>> restarts_;
+
+  double cosine(const hopf_point& a, const hopf_point& b) const { return structural_cosine(f_, a.p, b.p); }
+  std::string label_at(double m) const { return o_.label + " M=" + flutter_fixed(m, 4); }
+
+  hopf_options hopf_opts(const std::string& label) const {
+    hopf_options ho;
+    ho.symmetric = true;
+    ho.label = label;
+    ho.newton.abs_tolerance = o_.tolerance;
+    ho.newton.max_iterations = o_.max_iterations;
+    ho.newton.max_contraction = o_.max_contraction;
+    ho.newton.divergence_factor = o_.divergence_factor;
+    ho.verbose = o_.verbose;
+    ho.log = log_ ? log_ : &std::cout;
+    if (!log_) ho.verbose = false;
+    return ho;
+  }
+
+  void record(double m, const char* kind, std::string outcome, double seconds) {
+    b_.attempts.push_back({m, kind, std::move(outcome), seconds});
+  }
+
+  std::optional<flutter_boundary_point> hopf_at(const S& s, double mach, const solved_flow& st, const hopf_point& guess,
+                                                const std::string& label, const char* kind) {
+    hopf_point g = guess;
+    g.w = st.w;
+    hopf_krylov_options ko = o_.krylov;
+    ko.fill_level = o_.fill_level;
+    const hopf_options ho = hopf_opts(label);
+    const auto t0 = clk::now();
+    try {
+      hopf_result h = solve_hopf_krylov<B>(s, g, ho, ko);
+      if (o_.parameter_even) h.point.mu = std::abs(h.point.mu);
+      if (o_.verbose)
+        flutter_say(log_, "    %s: setup (assembly + BILU) %.3f s, GMRES %.3f s, residuals %.3f s\n", label.c_str(),
+                    h.setup_seconds, h.linear_seconds, h.residual_seconds);
+      flutter_boundary_point p;
+      p.mach = mach;
+      p.mu = h.point.mu;
+      p.omega = h.point.omega;
+      p.newton_iterations = h.report.iterations;
+      p.linear_iterations = h.linear_iterations;
+      p.hopf_seconds = flutter_seconds_since(t0);
+      p.steady_seconds = st.seconds;
+      p.point = h.point;
+      record(mach, kind, "converged", p.hopf_seconds);
+      return p;
+    } catch (const error& e) {
+      flutter_say(log_, "    %s failed: %s\n", label.c_str(), e.what());
+      record(mach, kind, std::string("failed: ") + e.what(), flutter_seconds_since(t0));
+      return std::nullopt;
+    }
+  }
+
+  void write(flutter_boundary_point p, double cos, bool jump = false) {
+    p.hopf_seconds += std::exchange(rejected_, 0.0);
+    p.cosine = cos;
+    p.jump = jump;
+    for (auto& fl : flows_) fl.settled = fl.settled || fl.charged;
+    pts_.push_back(p);
+    flutter_say(log_,
+                "  %-14s M = %.4f  mu* = %.6f  omega* = %.6f  Newton %d  GMRES %5ld  hopf %.2f s  steady %.2f s  (ratio "
+                "%.2f)  mode cosine %s\n",
+                o_.label.c_str(), p.mach, p.mu, p.omega, p.newton_iterations, p.linear_iterations, p.hopf_seconds,
+                p.steady_seconds, p.hopf_seconds / p.steady_seconds,
+                std::isfinite(cos) ? flutter_fixed(cos, 3).c_str() : "-");
+  }
+
+  /// Newton-Krylov from the two nearest solved flows; empty if it fails. ||f||_2 <= 1e-10: the
+  /// free-stream solve ends at 1e-10 .. 3e-8 (NACA 0012 coarse and medium grids); from the
+  /// interpolated flow the shock moves in 5-15 damped steps before the quadratic ones.
+  vec<double> warm_flow(const S& s, double m, double mu) {
+    std::vector<const solved_flow*> near;
+    for (const auto& fl : flows_) near.push_back(&fl);
+    std::sort(near.begin(), near.end(),
+              [&](const solved_flow* a, const solved_flow* e) { return std::abs(a->mach - m) < std::abs(e->mach - m); });
+    vec<double> w0 = near[0]->w;
+    if (near.size() > 1) w0 += (m - near[0]->mach) / (near[1]->mach - near[0]->mach) * (near[1]->w - near[0]->w);
+    const std::string label = o_.label + " steady Newton-Krylov at M = " + flutter_fixed(m, 5);
+    try {
+      equilibrium_krylov_options eo;
+      eo.fill_level = o_.fill_level;
+      eo.newton.abs_tolerance = 1e-10;
+      eo.newton.max_iterations = 25;
+      const auto r = solve_equilibrium_krylov<B>(s, mu, std::move(w0), eo, label);
+      flutter_say(log_, "    %s (from M = %.5f%s): %d Newton iterations, %ld GMRES, ||f|| %.2e -> %.2e, %.2f s\n",
+                  label.c_str(), near[0]->mach, near.size() > 1 ? (" and " + flutter_fixed(near[1]->mach, 5)).c_str() : "",
+                  r.report.iterations, r.linear_iterations, r.report.residual_history.front(), r.report.final_residual(),
+                  r.seconds);
+      return r.w;
+    } catch (const error& e) {
+      flutter_say(log_, "    %s failed: %s\n", label.c_str(), e.what());
+      return {};
+    }
+  }
+
+  /// A listed Mach number gets the equilibrium from scratch (the unit of cost) and keeps it; an
+  /// intermediate one (a halved step) a Newton-Krylov solve from the neighbouring flows, which is
+  /// also the fallback where the solve from scratch fails (e.g. ends on a lifting flow).
+  solved_flow& flow_at(const S& s, double m, double mu) {
+    for (auto& fl : flows_)
+      if (std::abs(fl.mach - m) < 1e-12) return fl;
+    const auto t0 = clk::now();
+    solved_flow fl{m, {}, 0, false, false};
+    if (!flutter_listed(machs_, m) && !flows_.empty()) fl.w = warm_flow(s, m, mu);
+    if (fl.w.size() == 0) {
+      try {
+        fl.w = f_.equilibrium(s, mu);
+      } catch (const convergence_error& e) {
+        if (flows_.empty()) throw;
+        flutter_say(log_, "    M = %.5f: %s\n    -> the equilibrium by Newton-Krylov from the neighbouring Mach numbers\n",
+                    m, e.what());
+        fl.w = warm_flow(s, m, mu);
+        if (fl.w.size() == 0) throw;
+      }
+    }
+    fl.seconds = flutter_seconds_since(t0);  // with the failed attempts, if any
+    flows_.push_back(std::move(fl));
+    return flows_.back();
+  }
+
+  /// charged: an attempt at m was rejected, its flow is lost work. A listed Mach number's steady
+  /// solve is never charged: it is the unit of cost of the point written there in the end.
+  void set_charged(double m, bool charged) {
+    if (flutter_listed(machs_, m)) return;
+    for (auto& fl : flows_)
+      if (std::abs(fl.mach - m) < 1e-12 && fl.charged != charged) {
+        if (!fl.settled) rejected_ += charged ? fl.seconds : -fl.seconds;
+        fl.charged = charged;
+      }
+  }
+
+  const flutter_boundary_point* coarse_at(double m) const {
+    if (!coarser_) return nullptr;
+    const auto cp = std::find_if(coarser_->points.begin(), coarser_->points.end(),
+                                 [&](const flutter_boundary_point& q) { return std::abs(q.mach - m) < 1e-9; });
+    return cp == coarser_->points.end() ? nullptr : &*cp;
+  }
+
+  /// The coarser boundary's point at m as a start on this level (its mu*, omega*, the
+  /// eigenvector prolonged).
+  std::optional<hopf_point> coarse_guess(const S& s, double m) const {
+    const flutter_boundary_point* cp = coarse_at(m);
+    if (!cp) return std::nullopt;
+    const S sc = f_.system(coarser_->level, m);
+    hopf_point guess = cp->point;
+    guess.p = f_.prolong(s, sc, cp->point.p);
+    return guess;
+  }
+
+  /// Grid sequencing at a listed Mach number where the start from the previous point failed;
+  /// tried once per Mach number (a second call reuses the result at no cost).
+  std::optional<flutter_boundary_point> coarse_restart(const S& s, double m, const solved_flow& st,
+                                                       const std::string& label) {
+    if (const auto it = restarts_.find(m); it != restarts_.end()) {
+      if (!it->second) return std::nullopt;
+      flutter_boundary_point q = *it->second;
+      q.hopf_seconds = 0;  // charged when it was solved
+      flutter_say(log_, "    %s: the coarse-grid restart found before: mu* = %.6f, omega* = %.6f\n", label.c_str(), q.mu,
+                  q.omega);
+      return q;
+    }
+    const auto t0 = clk::now();
+    const std::optional<hopf_point> guess = coarse_guess(s, m);
+    if (!guess) return std::nullopt;
+    flutter_say(log_, "    %s: restart from the coarse-grid point (mu* = %.6f, omega* = %.6f)\n", label.c_str(), guess->mu,
+                guess->omega);
+    auto q = hopf_at(s, m, st, *guess, label + " (coarse-grid restart)", "coarse restart");
+    if (q) q->hopf_seconds = flutter_seconds_since(t0);
+    restarts_[m] = q;
+    return q;
+  }
+
+  /// Secant and coarse-increment predictor of the start at m from the branch (class comment).
+  hopf_point predict(const S& s, double m, const solved_flow& st, const std::string& label) const;
+
+  std::vector<flutter_boundary_point> arclength_bridge(const flutter_boundary_point& from);
+};
+
+template <flutter_family F>
+hopf_point flutter_boundary_tracer<F>::predict(const S& s, double m, const solved_flow& st,
+                                               const std::string& label) const {
+  hopf_point guess = pts_.back().point;
+  // secant in M for mu, omega and the eigenvector, over a base no shorter than a tenth of the
+  // step: after an arclength stretch the last two points can lie 4e-5 apart in M, and a secant
+  // extrapolated 250 times its base is no predictor
+  const double min_base = 0.1 * (m - pts_.back().mach);
+  std::optional<std::size_t> i1;
+  for (std::size_t i = pts_.size() - 1; i-- > branch_start_;)
+    if (pts_.back().mach - pts_[i].mach >= min_base) {
+      i1 = i;
+      break;
+    }
+  if (i1) {
+    const auto& p1 = pts_[*i1];
+    const auto& p2 = pts_.back();
+    const double t = (m - p2.mach) / (p2.mach - p1.mach);
+    guess.mu = p2.mu + t * (p2.mu - p1.mu);
+    guess.omega = p2.omega + t * (p2.omega - p1.omega);
+    // p1 in the normalisation of p2 (same value at p2's largest component), then the secant
+    Eigen::Index k = 0;
+    p2.point.p.cwiseAbs().maxCoeff(&k);
+    if (std::abs(p1.point.p[k]) > 0) {
+      const vec<cplx> q1 = p1.point.p * (p2.point.p[k] / p1.point.p[k]);
+      guess.p = p2.point.p + t * (p2.point.p - q1);
+    }
+  }
+  // Coarse-increment predictor (a finer level, where the coarser boundary has points of one mode
+  // at both Mach numbers): the previous point plus the coarser boundary's change between them.
+  // Transonic boundaries wiggle as shocks cross cells, the same way on both grids (NACA 0012
+  // heavy, M 0.87 -> 0.88: coarse -0.513, medium -0.524 in Ubar*), which no secant can follow.
+  if (coarser_ && o_.predictor != coarse_predictor::off) {
+    const auto c0 = coarse_at(pts_.back().mach), c1 = coarse_at(m);
+    if (c0 && c1 && cosine(c0->point, c1->point) >= o_.same_mode_cosine) {
+      const flutter_boundary_point& p2 = pts_.back();
+      guess.mu = p2.mu + (c1->mu - c0->mu);
+      guess.omega = p2.omega + (c1->omega - c0->omega);
+      // the eigenvector from the coarser increment: always (full), never (values), or (automatic)
+      // where the secant eigenvector's Hopf residual at the predicted mu, omega exceeds the start
+      // refinement threshold (one inverse iteration takes the increment's to 3e-4 .. 5e-2, the
+      // secant one's to 2e-2 .. 6e-1, measured)
+      bool use_increment = o_.predictor == coarse_predictor::full;
+      if (o_.predictor == coarse_predictor::automatic) {
+        hopf_point h = guess;
+        h.w = st.w;
+        vec<double> y;
+        const symmetric_hopf_problem<S> pr(s, h, hopf_opts(label + " predictor"), "predictor", y);
+        const double f_secant = pr.residual(y).norm();
+        use_increment = !(f_secant <= o_.krylov.start_residual_threshold);
+        if (o_.verbose)
+          flutter_say(log_, "    %s: predictor ||F|| %.3e with the secant eigenvector: %s\n", label.c_str(), f_secant,
+                      use_increment ? "the coarser increment's instead" : "kept");
+      }
+      if (use_increment) {
+        Eigen::Index kc = 0, k = 0;
+        c0->point.p.cwiseAbs().maxCoeff(&kc);
+        p2.point.p.cwiseAbs().maxCoeff(&k);
+        const S sc = f_.system(coarser_->level, m);
+        const vec<cplx> d = c1->point.p * (c0->point.p[kc] / c1->point.p[kc]) - c0->point.p;
+        const vec<cplx> q0 = f_.prolong(s, sc, c0->point.p);
+        if (std::abs(q0[k]) > 0) guess.p = p2.point.p + (p2.point.p[k] / q0[k]) * f_.prolong(s, sc, d);
+      }
+    }
+  }
+  return guess;
+}
+
+/// Hand-over where natural continuation stops (a steep stretch where no Mach step lands in
+/// Newton's basin: NACA 0012 heavy coarse, M = 0.826-0.828, Ubar* peaks at ~6.1 while omega*
+/// moves from 0.20 to 0.41). The fixed-equilibrium tracer follows the curve from `from` up to
+/// the first listed Mach number above it that it lands on, or stops earlier where the curve
+/// turns back in M by more than fold_tolerance (the boundary is then another mode), retraces
+/// itself at a kink, or fails. Returns its points with M > from.mach in M order, the stretch's
+/// whole time charged to them.
+template <flutter_family F>
+std::vector<flutter_boundary_point> flutter_boundary_tracer<F>::arclength_bridge(const flutter_boundary_point& from) {
+  hopf_curve_options ho = o_.curve;
+  symmetric_hopf_curve_options so = o_.symmetric;
+  ho.nu_min = from.mach - 1e-9;
+  ho.nu_max = machs_.back();
+  ho.nu_targets.clear();
+  for (double m : machs_)
+    if (m > from.mach + 1e-9) ho.nu_targets.push_back(m);
+  ho.max_points = o_.handover_max_points;
+  ho.label = o_.label + " arclength";
+  ho.start.newton.abs_tolerance = o_.tolerance;
+  ho.newton.abs_tolerance = o_.tolerance;
+  ho.throw_on_failure = false;
+  ho.verbose = log_ != nullptr;
+  if (log_) ho.log = log_;
+  if (o_.verbose && log_) ho.newton.observer = newton_progress("      corrector", *log_);
+  so.fill_level = o_.fill_level;
+  if (!so.equilibrium_start) {
+    const F& fam = f_;
+    const int lev = level_;
+    const double mu0 = from.mu;
+    so.equilibrium_start = [&fam, lev, mu0](double mach) { return vec<double>(fam.equilibrium(fam.system(lev, mach), mu0)); };
+  }
+  double m_hi = from.mach;
+  std::vector<flutter_boundary_point> out;
+  so.observer = [&](const hopf_curve_point& p, const symmetric_hopf_curve_stats& st) {
+    if (p.nu <= m_hi + 1e-9) return;  // the start, or a point back in M
+    m_hi = p.nu;
+    hopf_point q = p.point();
+    if (o_.parameter_even) q.mu = std::abs(q.mu);
+    flutter_boundary_point bp;
+    bp.mach = p.nu;
+    bp.mu = q.mu;
+    bp.omega = p.omega;
+    bp.newton_iterations = p.newton_iterations;
+    bp.linear_iterations = st.linear_iterations;
+    bp.hopf_seconds = p.seconds;
+    bp.steady_seconds = from.steady_seconds;
+    bp.point = std::move(q);
+    bp.own_steady = false;
+    out.push_back(std::move(bp));
+  };
+  // A fold in M smaller than fold_tolerance is traced through (its points back in M are not
+  // boundary points). A RETRACE is different: at a kink the corrector can turn round and follow
+  // the curve back (NACA 0012 medium, M = 0.8276: 18 points with M falling by 1e-5 each): stop
+  // when a point comes within retrace_distance of the polyline of the trail before its last
+  // three points. A genuine fold moves away from it in omega (there: >= 0.7).
+  std::vector<Eigen::Vector3d> trail;
+  std::string why = "landed";
+  ho.stop_after = [&](const hopf_curve_point& p) {
+    const Eigen::Vector3d y(std::abs(p.mu) / ho.mu_scale, p.nu / ho.nu_scale, p.omega / ho.omega_scale);
+    const std::size_t n_old = trail.size() >= 3 ? trail.size() - 3 : 0;
+    double d = n_old > 0 ? (trail[0] - y).norm() : INFINITY;
+    for (std::size_t k = 0; k + 1 < n_old; ++k) {
+      const Eigen::Vector3d a = trail[k], e = trail[k + 1] - a;
+      const double t = e.squaredNorm() > 0 ? std::clamp((y - a).dot(e) / e.squaredNorm(), 0.0, 1.0) : 0.0;
+      d = std::min(d, (a + t * e - y).norm());
+    }
+    trail.push_back(y);
+    if (d < o_.retrace_distance) {
+      why = "retrace: the trace turned back along the curve at a kink";
+      return true;
+    }
+    if (p.nu < m_hi - o_.fold_tolerance) {
+      why = "the curve turns back in M by more than " + flutter_fixed(o_.fold_tolerance, 3);
+      return true;
+    }
+    return p.landed && p.nu > from.mach + 1e-9;
+  };
+  const F& fam = f_;
+  const int lev = level_;
+  auto family = [&fam, lev](double mach) { return fam.system(lev, mach); };
+  flutter_say(log_,
+              "    hand-over to pseudo-arclength continuation of the Hopf curve from M = %.5f (mu* = %.5f, omega* = "
+              "%.5f) up to the next listed Mach number\n",
+              from.mach, from.mu, from.omega);
+  symmetric_hopf_curve_result r;
+  const auto t_bridge = clk::now();
+  // the stretch's time not in its points' own steps (the re-solved start, points back in M, the
+  // step past the landed Mach number) goes to its last point
+  auto charge_rest = [&] {
+    if (out.empty()) return;
+    double own = 0;
+    for (const auto& q : out) own += q.hopf_seconds;
+    out.back().hopf_seconds += std::max(0.0, flutter_seconds_since(t_bridge) - own);
+  };
+  try {
+    r = trace_symmetric_hopf_curve<B>(family, from.mach, from.point, ho, +1, so);
+  } catch (const error& e) {  // e.g. the start's nested steady solve: keep what was traced
+    flutter_say(log_, "    arclength failed: %s\n", e.what());
+    charge_rest();
+    record(from.mach, "arclength", std::string("failed: ") + e.what(), flutter_seconds_since(t_bridge));
+    return out;
+  }
+  charge_rest();
+  long gmres_hopf = 0, gmres_steady = 0;
+  for (const auto& st : r.stats) {
+    gmres_hopf += st.linear_iterations;
+    gmres_steady += st.steady_linear_iterations;
+  }
+  const std::string stop = r.stop == hopf_curve_stop::requested ? why : r.stop_reason;
+  flutter_say(log_,
+              "    arclength (%s corrector): %zu points (%zu beyond M = %.5f), %d failed correctors, %d steps at fixed M "
+              "or mu, %d nested steady solves, %d flow Newton steps (%.2f s with dw0/dnu), GMRES %ld Hopf + %ld "
+              "steady and dw0/dnu, %.2f s; stop: %s\n",
+              so.joint_equilibrium ? "joint" : "nested", r.points.size(), out.size(), from.mach, r.failed_correctors,
+              r.kink_steps, r.steady_solves, r.steady_iterations, r.steady_seconds, gmres_hopf, gmres_steady, r.seconds,
+              stop.c_str());
+  record(from.mach, "arclength", std::to_string(out.size()) + " points; stop: " + stop, flutter_seconds_since(t_bridge));
+  return out;
+}
+
+template <flutter_family F>
+flutter_boundary flutter_boundary_tracer<F>::run() {
+  const std::vector<double>& machs = machs_;
+  for (double mach : machs) {
+    const double m_done = pts_.empty() ? mach : pts_.back().mach;
+    const double full_step = mach - m_done;
+    double step = full_step;
+    // the other mode's points found in this search (falling steps, so falling M), and the
+    // structural cosine of the last one to the branch's last point
+    std::vector<flutter_boundary_point> others;
+    double other_cosine = NAN;
+    while (pts_.empty() || pts_.back().mach < mach - 1e-9) {
+      if (!pts_.empty()) step = std::min(step, mach - pts_.back().mach);
+      const double m = pts_.empty() || step >= mach - pts_.back().mach ? mach : pts_.back().mach + step;
+      const S s = f_.system(level_, m);
+      const solved_flow& st = flow_at(s, m, pts_.empty() ? o_.start_mu : pts_.back().mu);
+      hopf_point guess;
+      const std::string label = label_at(m);
+      const auto t0 = clk::now();
+      // Coarse-guided restart: at the first attempt of a listed step across which the coarser
+      // boundary changes mode AND its branch ends within 1/4 of the step, the coarse-grid
+      // restart is solved at once (NACA 0012 heavy medium M = 0.90 -> 0.91: the start from the
+      // previous point took 7 Newton iterations to reach the other mode, the restart 3).
+      bool preempted = false;
+      if (o_.coarse_guided_restart && o_.coarse_restart && coarser_ && !pts_.empty() && std::abs(m - mach) < 1e-12 &&
+          std::abs(pts_.back().mach - m_done) < 1e-12 && flutter_listed(machs, m)) {
+        const flutter_boundary_point* c0 = coarse_at(m_done);
+        const flutter_boundary_point* c1 = coarse_at(m);
+        if (c0 && c1 && cosine(c0->point, c1->point) < o_.same_mode_cosine) {
+          double m_end = m_done;  // the coarser boundary's last point of c0's mode before m
+          for (const auto& q : coarser_->points)
+            if (q.mach > m_done + 1e-9 && q.mach < m - 1e-9 && cosine(c0->point, q.point) >= o_.same_mode_cosine)
+              m_end = std::max(m_end, q.mach);
+          preempted = m_end - m_done < 0.25 * full_step + 1e-12;
+          if (preempted)
+            flutter_say(log_,
+                        "    %s: the coarser boundary's branch ends at M = %.5f and it changes mode before M = %.4f: "
+                        "restart from its point first\n",
+                        label.c_str(), m_end, m);
+        }
+      }
+      const char* kind = "continued";
+      if (preempted) {
+        // the coarse-grid restart below is this attempt
+      } else if (!pts_.empty()) {
+        guess = predict(s, m, st, label);
+      } else if (coarser_) {  // grid sequencing from the coarser boundary at this Mach number
+        auto cg = coarse_guess(s, m);
+        require(cg.has_value(), o_.label, ": no coarse-grid point at M = ", m, " to start this level from");
+        guess = std::move(*cg);
+        kind = "first";
+      } else {
+        guess = hopf_start_krylov<B>(s, st.w, o_.start_mu, o_.start_omega, o_.fill_level, o_.start_restart, log_);
+        guess.mu = o_.start_mu;
+        kind = "first";
+      }
+      const double start_seconds = flutter_seconds_since(t0);
+      auto p = preempted ? std::nullopt : hopf_at(s, m, st, guess, label, kind);
+      auto t_attempt = t0;  // start of the attempt whose time a failure charges to rejected_
+      if (p) p->hopf_seconds += start_seconds;
+      const bool restarted = !p && o_.coarse_restart && coarser_ && !pts_.empty() && flutter_listed(machs, m);
+      if (restarted) {
+        set_charged(m, true);
+        rejected_ += flutter_seconds_since(t0);
+        t_attempt = clk::now();
+        p = coarse_restart(s, m, st, label);
+      }
+      double cos = NAN;
+      if (p && !pts_.empty()) cos = cosine(pts_.back().point, p->point);
+      if (!p) {
+        set_charged(m, true);
+        rejected_ += flutter_seconds_since(t_attempt);
+      }
+      if (p && pts_.size() > branch_start_ && cos < o_.same_mode_cosine) {
+        set_charged(m, true);
+        rejected_ += p->hopf_seconds;  // taken back if it becomes the jump point
+        flutter_say(log_,
+                    "    %s: Hopf point mu* = %.4f, omega* = %.4f belongs to another mode (structural cosine %.3f to "
+                    "the point at M = %.4f)\n",
+                    label.c_str(), p->mu, p->omega, cos, pts_.back().mach);
+        b_.attempts.back().outcome = "other mode";
+        others.push_back(std::move(*p));
+        other_cosine = cos;
+        p.reset();
+      }
+      if (p) {
+        set_charged(m, false);
+        b_.attempts.back().outcome = "accepted";
+        write(*p, cos);
+        others.clear();  // this branch goes on: the other mode's points above it are not boundary points
+        step = std::min(2.0 * step, full_step);
+        continue;
+      }
+      if (pts_.empty())
+        throw convergence_error(concat(o_.label, ": no Hopf point at the first Mach number ", m));
+      if (step < full_step / o_.min_step_divisor + 1e-12) {
+        if (!others.empty()) {
+          flutter_say(log_,
+                      "    %s: the branch continued from M = %.4f ends before M = %.4f (no Hopf point of its mode "
+                      "within 1/%d of the Mach step); the boundary jumps to the other mode's Hopf point found there\n",
+                      label.c_str(), pts_.back().mach, others.back().mach, o_.min_step_divisor);
+          branch_start_ = pts_.size();
+          // the other mode's points found at the larger steps lie on the new branch up to this
+          // listed Mach number: kept (not solved again) while each continues the branch
+          std::vector<std::pair<const flutter_boundary_point*, double>> kept = {{&others.back(), other_cosine}};
+          for (auto q = std::next(others.rbegin()); q != others.rend(); ++q) {
+            const flutter_boundary_point& last = *kept.back().first;
+            const double cq = cosine(last.point, q->point);
+            if (q->mach <= last.mach + 1e-9 || cq < o_.same_mode_cosine) break;
+            kept.emplace_back(&*q, cq);
+          }
+          for (const auto& [q, cq] : kept) {
+            rejected_ -= q->hopf_seconds;
+            set_charged(q->mach, false);
+          }
+          bool first = true;
+          for (const auto& [q, cq] : kept) {
+            write(*q, cq, first);
+            first = false;
+          }
+          others.clear();
+          step = std::min(2.0 * step, full_step);
+          continue;
+        }
+        flutter_say(log_, "    %s: no convergence from M = %.4f even with 1/%d of the Mach step\n", label.c_str(),
+                    pts_.back().mach, o_.min_step_divisor);
+        const double m_before = pts_.back().mach;
+        if (o_.handover)
+          for (auto& q : arclength_bridge(pts_.back())) {
+            const double cq = cosine(pts_.back().point, q.point);
+            write(q, cq);
+          }
+        if (pts_.back().mach <= m_before + 1e-9) {
+          flutter_say(log_, "    the boundary is not continued past M = %.5f (natural and arclength continuation failed)\n",
+                      m_before);
+          b_.stop_reason = "not continued past M = " + flutter_fixed(m_before, 5) +
+                           " (natural continuation down to 1/" + std::to_string(o_.min_step_divisor) +
+                           " of the step and the arclength hand-over failed)";
+          return std::move(b_);
+        }
+        step = full_step;  // natural continuation resumes from the stretch's last point
+        continue;
+      }
+      // Jump search from the bottom: where the start from the previous point CONVERGED to the
+      // other mode at the full listed step, the branch has most likely ended just past its last
+      // point, so the smallest step is tried first (NACA 0012: the branch ended within 1/8 of
+      // the step at two of the three such jumps). Where the start FAILED, the step is halved.
+      if (o_.jump_search_bottom && (!restarted || preempted) && !others.empty() &&
+          std::abs(others.back().mach - m) < 1e-12 && step > 0.5 * full_step) {
+        step = full_step / o_.min_step_divisor;
+        flutter_say(log_, "    the other mode at the full step: retrying with the smallest Mach step %g\n", step);
+        continue;
+      }
+      step *= 0.5;
+      flutter_say(log_, "    retrying with Mach step %g\n", step);
+    }
+  }
+  b_.complete = true;
+  return std::move(b_);
+}
+
+}  // namespace internal
+
+/// The crossing check of one boundary point: every imaginary-axis crossing of A0 + q(mu) B
+/// (axis_crossings.hpp) with omega in [omega_min, factor omega*]; PASS iff the lowest one above
+/// crossing_min_fraction mu* is the point itself. Needs the equilibrium independent of mu.
+template <flutter_family F>
+crossing_check_record check_flutter_crossing(const F& family, int level, const flutter_boundary_point& p,
+                                             const std::string& what, const flutter_boundary_options& o) {
+  const auto s = family.system(level, p.mach);
+  const vec<double>& w0 = p.point.w;
+  const double u1 = p.mu, u2 = 0.5 * p.mu;
+  const vec<std::complex<double>> sp_probe = family.structure_part(p.point.p);
+  const int ns = static_cast<int>(sp_probe.size());
+  const affine_split sp = split_affine(s.jacobian(w0, u1), family.stiffness_factor(u1), s.jacobian(w0, u2),
+                                       family.stiffness_factor(u2), ns, o.label + " crossing check");
+  axis_crossing_options ao;
+  ao.omega_min = o.crossing_omega_min;
+  ao.omega_max = o.crossing_omega_factor * p.omega;
+  ao.samples = std::max(100, static_cast<int>(std::ceil((ao.omega_max - ao.omega_min) / 0.02)));
+  ao.context = o.label + " crossing check";
+  const axis_crossing_result r = imaginary_axis_crossings(sp.a0, sp.b_ss, ao);
+  crossing_check_record c;
+  c.mach = p.mach;
+  c.mu = p.mu;
+  c.omega = p.omega;
+  c.what = what;
+  c.crossings = r.crossings.size();
+  const axis_crossing* lowest = nullptr;
+  for (const auto& x : r.crossings) {
+    if (!(x.q > 0)) continue;
+    const double u = family.parameter_of_factor(x.q);
+    c.all.emplace_back(u, x.omega);
+    if (u >= o.crossing_min_fraction * p.mu && (!lowest || x.q > lowest->q)) {
+      lowest = &x;
+      c.lowest_mu = u;
+    }
+  }
+  c.lowest_omega = lowest ? lowest->omega : NAN;
+  c.pass = lowest && std::abs(c.lowest_mu - p.mu) <= o.crossing_mu_tolerance * p.mu &&
+           std::abs(c.lowest_omega - p.omega) <= o.crossing_omega_tolerance;
+  return c;
+}
+
+/// The points of a boundary whose lowest-crossing property is checked: the jumps (structural
+/// cosine below same_mode_cosine to the previous point) and the last point.
+template <flutter_family F>
+std::vector<std::pair<std::size_t, const char*>> flutter_check_points(const F& family, const flutter_boundary& b,
+                                                                      double same_mode_cosine = 0.9) {
+  std::vector<std::pair<std::size_t, const char*>> at;
+  const auto& p = b.points;
+  for (std::size_t k = 1; k < p.size(); ++k)
+    if (structural_cosine(family, p[k - 1].point.p, p[k].point.p) < same_mode_cosine) at.emplace_back(k, "jump");
+  if (!p.empty() && (at.empty() || at.back().first != p.size() - 1)) at.emplace_back(p.size() - 1, "last point");
+  return at;
+}
+
+/// The flutter boundary of `family` on `level` at the listed Mach numbers (file comment).
+/// coarser: the boundary of a coarser level that family.refines(coarser->level, level), for grid
+/// sequencing (nullptr: none). Throws convergence_error if there is no Hopf point at the first
+/// Mach number; otherwise returns what it reached (complete, stop_reason) with the crossing
+/// checks of every jump and of the last point when opt.check_crossings.
+template <flutter_family F>
+flutter_boundary trace_flutter_boundary(const F& family, int level, const std::vector<double>& machs,
+                                        const flutter_boundary* coarser = nullptr,
+                                        const flutter_boundary_options& opt = {}) {
+  internal::check_flutter_boundary_options(opt, machs, opt.label);
+  if (coarser && !family.refines(coarser->level, level)) coarser = nullptr;
+  internal::flutter_boundary_tracer<F> t(family, level, machs, coarser, opt);
+  flutter_boundary b = t.run();
+  if (opt.check_crossings)
+    for (const auto& [k, what] : flutter_check_points(family, b, opt.same_mode_cosine)) {
+      const auto t0 = std::chrono::steady_clock::now();
+      crossing_check_record c = check_flutter_crossing(family, level, b.points[k], what, opt);
+      internal::flutter_say(opt.log,
+                            "    crossing check M = %.4f (%s)  mu* = %.5f omega* = %.4f: %zu crossings, lowest mu = %.5f at "
+                            "omega = %.4f -> %s  (%.1f s)\n",
+                            c.mach, what, c.mu, c.omega, c.crossings, c.lowest_mu, c.lowest_omega,
+                            c.pass ? "lowest crossing (PASS)" : "FAIL", internal::flutter_seconds_since(t0));
+      b.checks.push_back(std::move(c));
+    }
+  return b;
+}
+
+/// Cost per unit steady solve of a boundary (pure function of its points): the first point (with
+/// the inverse-power start) is left out of hopf_per_steady.
+inline flutter_boundary_costs boundary_costs(const flutter_boundary& b, const std::vector<double>& listed) {
+  flutter_boundary_costs c;
+  double hopf = 0, st = 0, extra = 0, st_listed = 0;
+  for (std::size_t k = 0; k < b.points.size(); ++k) {
+    const auto& q = b.points[k];
+    c.work_seconds += q.hopf_seconds + (q.own_steady ? q.steady_seconds : 0.0);
+    if (k == 0) continue;
+    hopf += q.hopf_seconds;
+    st += q.steady_seconds;
+    if (internal::flutter_listed(listed, q.mach)) {
+      st_listed += q.steady_seconds;
+      ++c.listed;
+    } else if (q.own_steady) {
+      extra += q.steady_seconds;  // a steady solve at an intermediate Mach number
+    }
+  }
+  c.continued = b.points.size() > 0 ? b.points.size() - 1 : 0;
+  if (c.continued > 0) c.hopf_per_steady = hopf / st;
+  if (c.listed > 0) c.hopf_per_steady_listed = (hopf + extra) / st_listed;
+  return c;
+}
+
+/// The same per listed steady solve of `fine`, with the coarser boundary's whole work charged.
+inline double boundary_cost_with_coarser(const flutter_boundary& fine, const flutter_boundary& coarse,
+                                         const std::vector<double>& listed) {
+  double hopf = 0, extra = 0, st_listed = 0;
+  for (std::size_t k = 1; k < fine.points.size(); ++k) {
+    const auto& q = fine.points[k];
+    hopf += q.hopf_seconds;
+    if (internal::flutter_listed(listed, q.mach))
+      st_listed += q.steady_seconds;
+    else if (q.own_steady)
+      extra += q.steady_seconds;
+  }
+  return (hopf + extra + boundary_costs(coarse, listed).work_seconds) / st_listed;
+}
+
+}  // namespace aerohopf

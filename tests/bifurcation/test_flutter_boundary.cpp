@@ -1,0 +1,220 @@
+// trace_flutter_boundary (bifurcation/flutter_boundary.hpp) on the pitch-plunge NACA 0012
+// (models/aerofoil_family.hpp), against the boundaries the aerofoil example computed with its own
+// copy of the algorithm before it moved into the library (tests/data/aerofoil_boundaries), the
+// coarse-increment predictor against natural continuation without it, the crossing check, the
+// cost figures as a pure function of the points, and bad input.
+#include <aerohopf/bifurcation/flutter_boundary.hpp>
+#include <aerohopf/flow/naca_cgrid.hpp>
+#include <aerohopf/models/aerofoil_family.hpp>
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "support/error_messages.hpp"
+
+using namespace aerohopf;
+using aerohopf::models::aerofoil_family;
+
+namespace {
+
+static_assert(flutter_family<aerofoil_family>);
+
+struct reference_point {
+  double mach, ubar, omega;
+};
+
+std::vector<reference_point> read_reference(const std::string& name) {
+  const auto path = std::filesystem::path(__FILE__).parent_path().parent_path() / "data" / "aerofoil_boundaries" / name;
+  std::ifstream f(path);
+  EXPECT_TRUE(f.good()) << path;
+  std::string line;
+  std::getline(f, line);
+  EXPECT_EQ(line, "mach,ubar,omega");
+  std::vector<reference_point> r;
+  while (std::getline(f, line)) {
+    std::istringstream is(line);
+    reference_point p{};
+    char c1 = 0, c2 = 0;
+    is >> p.mach >> c1 >> p.ubar >> c2 >> p.omega;
+    EXPECT_TRUE(is && c1 == ',' && c2 == ',') << line;
+    r.push_back(p);
+  }
+  return r;
+}
+
+/// The listed Mach numbers of spec 05: 0.50 .. 0.80 step 0.05, 0.81 .. 0.95 step 0.01.
+std::vector<double> listed_machs(double from = 0.5) {
+  std::vector<double> m;
+  for (int k = 0; k <= 6; ++k) m.push_back(std::round((0.5 + 0.05 * k) * 1e4) / 1e4);
+  for (int k = 1; k <= 15; ++k) m.push_back(std::round((0.80 + 0.01 * k) * 1e4) / 1e4);
+  std::vector<double> r;
+  for (double x : m)
+    if (x >= from - 1e-9) r.push_back(x);
+  return r;
+}
+
+aerofoil_family family(double mu_s) {
+  structure::pitch_plunge_parameters p;
+  p.mu_s = mu_s;
+  return aerofoil_family(flow::naca_cgrid(), p);
+}
+
+/// The options the aerofoil example passes (examples/aerofoil_flutter: setup.hpp's tracer metric).
+flutter_boundary_options options_for(double ubar_guess, double omega_guess, const std::string& label) {
+  flutter_boundary_options o;
+  o.start_mu = ubar_guess;
+  o.start_omega = omega_guess;
+  o.parameter_even = true;
+  o.label = label;
+  o.log = nullptr;
+  o.check_crossings = false;
+  hopf_curve_options& ho = o.curve;
+  ho.mu_scale = 0.5;
+  ho.nu_scale = 0.01;
+  ho.omega_scale = 0.05;
+  ho.max_step = 1.0;
+  ho.step = 0.5;
+  ho.min_step = 1e-3;
+  ho.mu_min = 0.2;
+  ho.mu_max = 20.0;
+  ho.fast_iterations = 4;
+  ho.newton.max_iterations = 8;
+  ho.newton.max_contraction = 1.0;
+  ho.start.newton.max_iterations = 20;
+  o.symmetric.steady.abs_tolerance = 1e-10;
+  o.symmetric.derivative_tolerance = 1e-4;
+  return o;
+}
+
+/// Every reference point has a boundary point at the same Mach number with Ubar*, omega* within
+/// 3e-5 relative (the Newton tolerance fixes Ubar* to ~2e-5 on the heavy boundaries), and the
+/// same number of points.
+void expect_matches(const flutter_boundary& b, const std::vector<reference_point>& ref) {
+  ASSERT_EQ(b.points.size(), ref.size()) << b.label;
+  for (std::size_t k = 0; k < ref.size(); ++k) {
+    const auto& p = b.points[k];
+    EXPECT_NEAR(p.mach, ref[k].mach, 1e-6) << b.label << " point " << k;
+    EXPECT_NEAR(p.mu / ref[k].ubar, 1.0, 3e-5) << b.label << " M = " << p.mach;
+    EXPECT_NEAR(p.omega / ref[k].omega, 1.0, 3e-5) << b.label << " M = " << p.mach;
+  }
+}
+
+TEST(FlutterBoundary, LightCoarseEqualsTheExamplesBoundary) {
+  const auto f = family(10.0);
+  const auto machs = listed_machs();
+  const flutter_boundary b = trace_flutter_boundary(f, 4, machs, nullptr, options_for(1.66, 0.75, "light coarse"));
+  EXPECT_TRUE(b.complete) << b.stop_reason;
+  expect_matches(b, read_reference("boundary_light_coarse.csv"));
+  // attempts: every accepted point has its record, the first is the inverse-power start
+  ASSERT_FALSE(b.attempts.empty());
+  EXPECT_EQ(b.attempts.front().kind, "first");
+  const auto accepted = std::count_if(b.attempts.begin(), b.attempts.end(),
+                                      [](const flutter_attempt& a) { return a.outcome == "accepted"; });
+  EXPECT_EQ(static_cast<std::size_t>(accepted), b.points.size());
+  const flutter_boundary_costs c = boundary_costs(b, machs);
+  EXPECT_EQ(c.listed, machs.size() - 1);
+  EXPECT_GT(c.hopf_per_steady_listed, 0.0);
+}
+
+// The heavy case jumps to the other mode near M = 0.90 and hands over to the Hopf-curve tracer
+// over the steep stretch near M = 0.827 (spec 05): the driver's whole repertoire.
+TEST(FlutterBoundary, HeavyCoarseEqualsTheExamplesBoundary) {
+  const auto f = family(100.0);
+  flutter_boundary_options o = options_for(4.6, 0.22, "heavy coarse");
+  o.check_crossings = true;
+  const flutter_boundary b = trace_flutter_boundary(f, 4, listed_machs(), nullptr, o);
+  EXPECT_TRUE(b.complete) << b.stop_reason;
+  expect_matches(b, read_reference("boundary_heavy_coarse.csv"));
+  EXPECT_TRUE(std::any_of(b.points.begin(), b.points.end(), [](const flutter_boundary_point& p) { return p.jump; }));
+  EXPECT_TRUE(std::any_of(b.points.begin(), b.points.end(), [](const flutter_boundary_point& p) { return !p.own_steady; }));
+  EXPECT_TRUE(std::any_of(b.attempts.begin(), b.attempts.end(), [](const flutter_attempt& a) { return a.kind == "arclength"; }));
+  // the crossing check: the jump and the last point are the lowest crossings of the imaginary axis
+  ASSERT_EQ(b.checks.size(), 2u);
+  EXPECT_EQ(b.checks.front().what, "jump");
+  EXPECT_EQ(b.checks.back().what, "last point");
+  EXPECT_TRUE(b.checks_passed());
+  for (const auto& c : b.checks) EXPECT_NEAR(c.lowest_mu / c.mu, 1.0, 1e-5) << "M = " << c.mach;
+}
+
+// Grid sequencing (very coarse -> coarse) and the coarse-increment predictor change the starts
+// only, never the points: the light coarse boundary M = 0.75 .. 0.95 with and without them lists
+// the same Mach numbers with the same Ubar*, omega* to the Newton tolerance.
+TEST(FlutterBoundary, CoarsePredictorChangesStartsNotPoints) {
+  const auto f = family(10.0);
+  const auto machs = listed_machs(0.75);
+  const flutter_boundary_options o = options_for(1.66, 0.75, "light");
+  const flutter_boundary vc = trace_flutter_boundary(f, 8, machs, nullptr, o);
+  ASSERT_TRUE(vc.complete) << vc.stop_reason;
+  flutter_boundary_options with = o, without = o;
+  std::ostringstream log;
+  with.log = &log;
+  with.verbose = true;
+  without.predictor = coarse_predictor::off;
+  without.coarse_guided_restart = false;
+  const flutter_boundary a = trace_flutter_boundary(f, 4, machs, &vc, with);
+  const flutter_boundary b = trace_flutter_boundary(f, 4, machs, &vc, without);
+  std::size_t used = 0;
+  for (std::size_t at = log.str().find("predictor ||F||"); at != std::string::npos;
+       at = log.str().find("predictor ||F||", at + 1))
+    ++used;
+  EXPECT_GE(used, 10u);  // one per continued coarse point
+  std::size_t n = 0;
+  for (const auto& p : a.points) {
+    if (!internal::flutter_listed(machs, p.mach)) continue;
+    const auto q = std::find_if(b.points.begin(), b.points.end(),
+                                [&](const flutter_boundary_point& x) { return std::abs(x.mach - p.mach) < 1e-9; });
+    ASSERT_NE(q, b.points.end()) << "M = " << p.mach;
+    EXPECT_NEAR(p.mu / q->mu, 1.0, 1e-4) << "M = " << p.mach;
+    EXPECT_NEAR(p.omega / q->omega, 1.0, 1e-4) << "M = " << p.mach;
+    ++n;
+  }
+  EXPECT_EQ(n, machs.size());
+}
+
+TEST(FlutterBoundary, CostsArePureFunctionsOfThePoints) {
+  flutter_boundary b;
+  auto pt = [](double m, double hopf, double st, bool own) {
+    flutter_boundary_point p;
+    p.mach = m;
+    p.hopf_seconds = hopf;
+    p.steady_seconds = st;
+    p.own_steady = own;
+    return p;
+  };
+  b.points = {pt(0.5, 9.0, 1.0, true), pt(0.55, 1.0, 2.0, true), pt(0.575, 0.5, 1.0, true), pt(0.6, 2.0, 2.0, true),
+              pt(0.61, 1.0, 2.0, false)};
+  const std::vector<double> listed{0.5, 0.55, 0.6};
+  const auto c = boundary_costs(b, listed);
+  EXPECT_EQ(c.continued, 4u);
+  EXPECT_EQ(c.listed, 2u);
+  EXPECT_DOUBLE_EQ(c.hopf_per_steady, (1.0 + 0.5 + 2.0 + 1.0) / (2.0 + 1.0 + 2.0 + 2.0));
+  // beyond one steady solve per listed Mach number: the Hopf work and the intermediate steady solve
+  EXPECT_DOUBLE_EQ(c.hopf_per_steady_listed, (1.0 + 0.5 + 2.0 + 1.0 + 1.0) / (2.0 + 2.0));
+  EXPECT_DOUBLE_EQ(c.work_seconds, 9 + 1 + 1 + 2 + 0.5 + 1 + 2 + 2 + 1);
+  flutter_boundary coarse;
+  coarse.points = {pt(0.5, 1.0, 0.5, true), pt(0.55, 0.5, 0.5, false)};
+  EXPECT_DOUBLE_EQ(boundary_cost_with_coarser(b, coarse, listed), (1.0 + 0.5 + 2.0 + 1.0 + 1.0 + 2.0) / 4.0);
+}
+
+TEST(FlutterBoundary, BadInputIsRefused) {
+  const auto f = family(10.0);
+  flutter_boundary_options o = options_for(1.66, 0.75, "bad");
+  EXPECT_TRUE(test::contains(test::input_error_of([&] { trace_flutter_boundary(f, 8, {}, nullptr, o); }), "no Mach numbers"));
+  EXPECT_TRUE(test::contains(test::input_error_of([&] { trace_flutter_boundary(f, 8, {0.6, 0.5}, nullptr, o); }),
+                             "must increase"));
+  EXPECT_TRUE(test::contains(test::input_error_of([&] { trace_flutter_boundary(f, 8, {0.5, NAN}, nullptr, o); }),
+                             "Mach number 1"));
+  o.start_omega = -1;
+  EXPECT_TRUE(test::contains(test::input_error_of([&] { trace_flutter_boundary(f, 8, {0.5}, nullptr, o); }),
+                             "start_omega"));
+  o = options_for(1.66, 0.75, "bad");
+  o.same_mode_cosine = 1.5;
+  EXPECT_TRUE(test::contains(test::input_error_of([&] { trace_flutter_boundary(f, 8, {0.5}, nullptr, o); }),
+                             "same_mode_cosine"));
+}
+
+}  // namespace
