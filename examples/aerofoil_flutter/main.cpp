@@ -9,6 +9,10 @@
 //                               each finer one starts from and uses the one before it
 //   --mach-min M --mach-max M   Mach range (default 0.5 .. 0.95; steps 0.05, and 0.01 from 0.80)
 //   --mach-step d               one uniform step instead of the default list
+//   --incidence DEG             mean angle of attack (default 0): the equilibrium is then the static
+//                               aeroelastic one and moves with Ubar, each point a FULL Hopf system
+//                               (Krylov, the flow update by block elimination); writes
+//                               boundary_<case>_<grid>_alpha<DEG>.csv with the static pitch deflection
 //   --skip-spectra --skip-boundaries --skip-vg --skip-jump-check --skip-verify --skip-reduced   parts to leave out
 //                               (--skip-jump-check: also the driver's crossing check)
 //   --vg-mach M                 Mach number of the V-g / V-f diagrams (default 0.80)
@@ -23,6 +27,8 @@
 //
 // Outputs under out_dir (default out/aerofoil_flutter):
 //   boundary_<case>_<grid>.csv  mach,ubar,omega,newton_iterations,linear_iterations,hopf_seconds,steady_seconds
+//                               (at --incidence: boundary_<case>_<grid>_alpha<DEG>.csv, plus static_alpha:
+//                               the static pitch deflection at the flutter point, radians)
 //   crossing_check.csv (case,grid,mach,ubar_star,omega_star,ubar,omega)   every imaginary-axis crossing at
 //                               the jumps and last points (the library driver's check)
 //   flutter_point_very_coarse.txt, spectra.csv (ubar,re,im)     very coarse, light, M = 0.5
@@ -40,6 +46,7 @@
 #include <filesystem>
 #include <iostream>
 #include <map>
+#include <numbers>
 #include <string>
 #include <vector>
 
@@ -59,7 +66,8 @@ flutter_boundary_options driver_options(const options& o, const structural_case&
   fo.start_mu = c.ubar_guess;
   fo.start_omega = c.omega_guess;
   fo.fill_level = o.fill;
-  fo.parameter_even = true;
+  fo.parameter_even = true;  // Ubar enters only through 1/Ubar^2, also at incidence
+  fo.moving_equilibrium = o.incidence_deg != 0.0;
   fo.verbose = o.verbose;
   fo.label = c.name + " " + g.name;
   const tracer_options t = aerofoil_tracer_options(g, c, machs.front(), machs.back(), o.fill);
@@ -74,13 +82,24 @@ flutter_boundary_options driver_options(const options& o, const structural_case&
 flutter_boundary boundary_on(const options& o, const structural_case& c, const grid_level& g,
                              const flutter_boundary* coarser) {
   const auto machs = mach_list(o);
-  const auto family = family_of(c);
+  const auto family = family_of(c, o.incidence_deg * std::numbers::pi / 180);
   flutter_boundary b = trace_flutter_boundary(family, g.stride, machs, coarser, driver_options(o, c, g, machs));
-  csv_writer csv(o.out / ("boundary_" + c.name + "_" + g.name + ".csv"),
-                 "mach,ubar,omega,newton_iterations,linear_iterations,hopf_seconds,steady_seconds");
-  for (const auto& p : b.points)
-    csv.row({p.mach, p.mu, p.omega, static_cast<long long>(p.newton_iterations),
-             static_cast<long long>(p.linear_iterations), p.hopf_seconds, p.steady_seconds});
+  const bool moving = o.incidence_deg != 0.0;
+  char tag[64] = "";
+  if (moving) std::snprintf(tag, sizeof tag, "_alpha%g", o.incidence_deg);
+  csv_writer csv(o.out / ("boundary_" + c.name + "_" + g.name + tag + ".csv"),
+                 std::string("mach,ubar,omega,newton_iterations,linear_iterations,hopf_seconds,steady_seconds") +
+                     (moving ? ",static_alpha" : ""));
+  for (const auto& p : b.points) {
+    // the pitch unknown of the equilibrium at the flutter point (h, h', alpha, alpha' last)
+    const double static_alpha = p.point.w[p.point.w.size() - 2];
+    if (moving)
+      csv.row({p.mach, p.mu, p.omega, static_cast<long long>(p.newton_iterations),
+               static_cast<long long>(p.linear_iterations), p.hopf_seconds, p.steady_seconds, static_alpha});
+    else
+      csv.row({p.mach, p.mu, p.omega, static_cast<long long>(p.newton_iterations),
+               static_cast<long long>(p.linear_iterations), p.hopf_seconds, p.steady_seconds});
+  }
   if (!b.complete) std::cout << "  " << b.label << ": boundary incomplete: " << b.stop_reason << "\n";
   return b;
 }
@@ -191,6 +210,10 @@ options parse(int argc, char** argv) {
     } else if (a == "--mach-step") {
       o.mach_step = number();
       require(o.mach_step > 0, "--mach-step must be > 0");
+    } else if (a == "--incidence") {
+      o.incidence_deg = number();
+      require(std::abs(o.incidence_deg) < 10, "--incidence: a mean angle of attack in degrees, |alpha| < 10 (got ",
+              o.incidence_deg, ")");
     } else if (a == "--contact-smoothing") {
       o.contact_smoothing = number();
       require(o.contact_smoothing >= 0, "--contact-smoothing must be >= 0");
@@ -241,6 +264,11 @@ options parse(int argc, char** argv) {
   }
   require(o.mach_min > 0 && o.mach_max >= o.mach_min && o.mach_max < 1, "need 0 < --mach-min <= --mach-max < 1 (got ",
           o.mach_min, ", ", o.mach_max, ")");
+  if (o.incidence_deg != 0.0 && (o.spectra || o.jump_check || o.verify || o.reduced)) {
+    std::cout << "(--incidence: the spectra, jump check, time marching and reduced-model parts assume zero incidence; "
+                 "skipped)\n";
+    o.spectra = o.jump_check = o.verify = o.reduced = false;
+  }
   if (o.quick) {
     o.jump_check = false;
     o.grids = {level_named("coarse")};

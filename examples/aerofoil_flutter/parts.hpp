@@ -44,6 +44,7 @@ struct options {
   std::vector<structural_case> cases{light_case, heavy_case};
   std::vector<grid_level> grids{level_named("coarse"), level_named("medium")};
   double mach_min = 0.5, mach_max = 0.95, mach_step = 0;
+  double incidence_deg = 0;  // mean angle of attack: a moving (static aeroelastic) equilibrium
   int fill = flutter_boundary_options{}.fill_level;
   double contact_smoothing = 0.05;  // of the reduced model's discretisation (osher_flux.hpp)
   bool spectra = true, boundaries = true, jump_check = true, verify = true, reduced = true, quick = false;
@@ -167,13 +168,16 @@ inline void vg_part(const options& o, const boundaries& all) {
               << " ===\n";
     try {
       const auto t0 = clk::now();
-      const auto s = make_system(g, o.vg_mach, c.mu_s);
-      const auto st = steady(s);
+      const auto family = family_of(c, o.incidence_deg * std::numbers::pi / 180);
+      const auto s = family.system(g.stride, o.vg_mach);
       // the Hopf point of this run's boundary at vg_mach, else one Hopf solve from the inverse-power start
       std::optional<flutter_boundary_point> hp;
       if (const auto it = all.find(c.name + "_" + g.name); it != all.end())
         for (const auto& q : it->second.points)
           if (std::abs(q.mach - o.vg_mach) < 1e-9) hp = q;
+      require(hp.has_value() || family.fixed_equilibrium(), "no boundary point at M = ", o.vg_mach,
+              " at this incidence (the V-g diagram's range is set by it)");
+      const steady_result st = family.fixed_equilibrium() ? steady(s) : steady_result{};
       if (!hp) hp = single_hopf_point(o, s, st, c, c.name + " " + g.name + " V-g Hopf point");
       require(hp.has_value(), "no Hopf point at M = ", o.vg_mach, " to set the Ubar range");
       std::vector<double> ubars;
@@ -184,7 +188,11 @@ inline void vg_part(const options& o, const boundaries& all) {
       vo.tracked_size = aerofoil_system::n_structure;
       vo.inverse_power.tolerance = 1e-10;
       const auto starts = vg_mode_starts(s.structure().in_vacuo_matrix(ubars.front()));  // plunge, pitch
-      const auto equilibrium = [&](double) { return st.w; };  // symmetric section: one flow for every Ubar
+      // symmetric section at zero incidence: one flow for every Ubar; else the static aeroelastic
+      // equilibrium at each Ubar (the root locus then includes the aerostatic deflection)
+      const auto equilibrium = [&](double ubar) {
+        return family.fixed_equilibrium() ? st.w : family.static_equilibrium(s, ubar, o.fill);
+      };
       vg_result r;
       const bool lu = o.vg_solver == "lu" || (o.vg_solver == "auto" && g.stride >= 4);
       if (lu) {  // sparse LU of A - sigma I

@@ -122,6 +122,12 @@ struct flutter_boundary_options {
   coarse_predictor predictor = coarse_predictor::automatic;
   /// mu enters the system only through mu^2 (the aerofoil's 1/Ubar^2): -mu* is the same point.
   bool parameter_even = false;
+  /// The equilibrium moves with mu (e.g. a mean incidence: the static aeroelastic deflection
+  /// depends on Ubar): each point is a FULL Hopf system solved by solve_hopf_krylov with
+  /// hopf_krylov_options::full_system (no start refinement), the family's equilibrium(s, mu) is
+  /// the static aeroelastic solve, and neither the fixed-equilibrium tracer hand-over nor the
+  /// crossing check (both assume A0 independent of mu) applies: they are skipped.
+  bool moving_equilibrium = false;
   /// Hand-over to the fixed-equilibrium Hopf-curve tracer (its step metric and bounds are the
   /// model's: set curve.mu_scale, nu_scale, omega_scale, mu_min, mu_max, symmetric.fill_level...).
   bool handover = true;
@@ -330,9 +336,9 @@ class flutter_boundary_tracer {
   double cosine(const hopf_point& a, const hopf_point& b) const { return structural_cosine(f_, a.p, b.p); }
   std::string label_at(double m) const { return o_.label + " M=" + flutter_fixed(m, 4); }
 
-  hopf_options hopf_opts(const std::string& label) const {
+  hopf_options hopf_opts(const std::string& label, bool fixed = true) const {
     hopf_options ho;
-    ho.symmetric = true;
+    ho.symmetric = fixed;
     ho.label = label;
     ho.newton.abs_tolerance = o_.tolerance;
     ho.newton.max_iterations = o_.max_iterations;
@@ -354,7 +360,11 @@ class flutter_boundary_tracer {
     g.w = st.w;
     hopf_krylov_options ko = o_.krylov;
     ko.fill_level = o_.fill_level;
-    const hopf_options ho = hopf_opts(label);
+    if (o_.moving_equilibrium) {
+      ko.full_system = true;
+      ko.start_iterations = 0;
+    }
+    const hopf_options ho = hopf_opts(label, !o_.moving_equilibrium);
     const auto t0 = clk::now();
     try {
       hopf_result h = solve_hopf_krylov<B>(s, g, ho, ko);
@@ -820,7 +830,9 @@ flutter_boundary flutter_boundary_tracer<F>::run() {
         flutter_say(log_, "    %s: no convergence from M = %.4f even with 1/%d of the Mach step\n", label.c_str(),
                     pts_.back().mach, o_.min_step_divisor);
         const double m_before = pts_.back().mach;
-        if (o_.handover)
+        if (o_.handover && o_.moving_equilibrium)
+          flutter_say(log_, "    no hand-over: the Hopf-curve tracer assumes a fixed equilibrium\n");
+        if (o_.handover && !o_.moving_equilibrium)
           for (auto& q : arclength_bridge(pts_.back())) {
             const double cq = cosine(pts_.back().point, q.point);
             write(q, cq);
@@ -923,7 +935,7 @@ flutter_boundary trace_flutter_boundary(const F& family, int level, const std::v
   if (coarser && !family.refines(coarser->level, level)) coarser = nullptr;
   internal::flutter_boundary_tracer<F> t(family, level, machs, coarser, opt);
   flutter_boundary b = t.run();
-  if (opt.check_crossings)
+  if (opt.check_crossings && !opt.moving_equilibrium)
     for (const auto& [k, what] : flutter_check_points(family, b, opt.same_mode_cosine)) {
       const auto t0 = std::chrono::steady_clock::now();
       crossing_check_record c = check_flutter_crossing(family, level, b.points[k], what, opt);

@@ -5,11 +5,16 @@
 // section at rest (symmetric section at zero incidence: the same for every Ubar), injection
 // between levels of ratio 2, the structural unknowns (h, h', alpha, alpha') for the mode test,
 // and Ubar entering the stiffness as 1/Ubar^2 (the crossing check).
+// At a non-zero angle of attack the flow loads the section, so the equilibrium is the static
+// aeroelastic one and moves with Ubar (spec 05, "A moving equilibrium"): static_equilibrium
+// solves it by Newton-Krylov on the coupled system from the steady flow about the section at
+// rest (pseudo-transient, the unit of cost).
 #include <cmath>
 #include <complex>
 #include <string>
 #include <utility>
 
+#include "../bifurcation/equilibrium_krylov.hpp"
 #include "../error.hpp"
 #include "../flow/euler_model.hpp"
 #include "../flow/steady_solver.hpp"
@@ -50,9 +55,42 @@ class aerofoil_family {
     }
   }
 
-  /// The steady flow from the free stream with the section at rest (aerofoil_system::
-  /// steady_equilibrium: throws convergence_error if the flow loads the section).
-  vec<double> equilibrium(const aerofoil_system& s, double /*ubar*/) const { return s.steady_equilibrium(steady_); }
+  /// The equilibrium of s at Ubar: at zero incidence the steady flow from the free stream with
+  /// the section at rest (aerofoil_system::steady_equilibrium: throws convergence_error if the
+  /// flow loads the section), the same for every Ubar; else static_equilibrium.
+  vec<double> equilibrium(const aerofoil_system& s, double ubar) const {
+    return alpha_ == 0.0 ? s.steady_equilibrium(steady_) : static_equilibrium(s, ubar);
+  }
+
+  /// true: the equilibrium does not depend on Ubar (zero incidence), the fixed-equilibrium Hopf
+  /// system applies.
+  bool fixed_equilibrium() const { return alpha_ == 0.0; }
+
+  /// The static aeroelastic equilibrium at Ubar: the steady flow about the section at rest
+  /// (solve_steady from the free stream), then Newton-Krylov on the coupled system
+  /// (solve_equilibrium_krylov, BILU(fill), ||f||_2 <= tolerance) for the deflected section and
+  /// its flow. Throws convergence_error naming the stage that failed.
+  vec<double> static_equilibrium(const aerofoil_system& s, double ubar, int fill = 2, double tolerance = 1e-10) const {
+    require(std::isfinite(ubar) && ubar != 0.0, "aerofoil_family::static_equilibrium: Ubar = ", ubar);
+    flow::euler_model<2> f = s.flow();
+    vec<double> wf = f.free_stream_vector();
+    const auto report = flow::solve_steady<2>(f, wf, steady_);
+    if (!report.converged)
+      throw convergence_error(internal::concat("aerofoil_family::static_equilibrium: the steady flow about the section at "
+                                               "rest did not converge at M = ", s.flow().conditions().mach));
+    vec<double> w = s.free_stream_state();
+    w.head(s.flow_size()) = wf;
+    equilibrium_krylov_options eo;
+    eo.fill_level = fill;
+    eo.newton.abs_tolerance = tolerance;
+    // from the section at rest the line search damps the first 5-15 steps (the flow has to follow
+    // the deflected wall: NACA 0012 coarse, alpha_0 = 1 deg, Ubar = 1.6), then 3-4 quadratic ones
+    eo.newton.max_iterations = 40;
+    return solve_equilibrium_krylov<block_size>(s, ubar, std::move(w), eo,
+                                                internal::concat("aerofoil_family::static_equilibrium at M = ",
+                                                                 s.flow().conditions().mach, ", Ubar = ", ubar))
+        .w;
+  }
 
   bool refines(int coarse_stride, int fine_stride) const { return coarse_stride == 2 * fine_stride; }
 
