@@ -2,7 +2,8 @@
 // does, the tubular reactor and models with a run-time, non-positive or mismatched block size
 // do not), the compile-time block-size check (block_system_of as a constraint, require_block_size
 // in a constant expression), the aerofoil's jacobians() pair against its single block
-// assemblies and its Eigen sparse Jacobians bit for bit, and checked_jacobians' size checks.
+// assemblies and its Eigen sparse Jacobians bit for bit, and the size checks of
+// checked_jacobians / checked_exact_jacobian.
 #include <gtest/gtest.h>
 
 #include <aerohopf/flow/naca_cgrid.hpp>
@@ -149,6 +150,7 @@ TEST(block_system, aerofoil_pair_equals_the_single_block_assemblies_bit_for_bit)
   EXPECT_EQ(p.exact.rows(), s.size());  // 4 per cell + 4 structural unknowns: no padding
   expect_identical(p.exact, s.block_jacobian(w, mu), "exact");
   expect_identical(p.preconditioning, s.approximate_block_jacobian(w, mu), "preconditioning");
+  expect_identical(checked_exact_jacobian(s, w, mu, "test"), p.exact, "checked_exact_jacobian");
   const auto [e, a] = s.block_jacobians(w, mu);  // the old pair interface
   expect_identical(e, p.exact, "block_jacobians().first");
   expect_identical(a, p.preconditioning, "block_jacobians().second");
@@ -180,9 +182,17 @@ TEST(block_system, checked_jacobians_compares_the_pair_with_the_system_size) {
   vec<double> y(6);
   p.preconditioning.apply(x, y);
   for (Eigen::Index i = 0; i < 5; ++i) EXPECT_EQ(y[i], 2.0 * (-2.0 - 0.1 * double(i)) * x[i]);
+  // no block_jacobian member: the exact matrix of the pair
+  static_assert(!has_exact_block_jacobian<small_block_system> && has_exact_block_jacobian<aerofoil_system>);
+  EXPECT_EQ(checked_exact_jacobian(ok, w, 2.0, "small").values(), p.exact.values());
   small_block_system bad;
   bad.wrong_size = true;
-  const std::string msg = input_error_of([&] { (void)checked_jacobians(bad, w, 2.0, "small system"); });
-  EXPECT_TRUE(contains(msg, "small system: exact block Jacobian is 3x3")) << msg;
-  EXPECT_TRUE(contains(msg, "system has 5 unknowns")) << msg;
+  for (const bool exact_only : {false, true}) {
+    const std::string msg = input_error_of([&] {
+      if (exact_only) (void)checked_exact_jacobian(bad, w, 2.0, "small system");
+      else (void)checked_jacobians(bad, w, 2.0, "small system");
+    });
+    EXPECT_TRUE(contains(msg, "small system: exact block Jacobian is 3x3 (padded 4x4)")) << msg;
+    EXPECT_TRUE(contains(msg, "system has 5 unknowns (padded 6)")) << msg;
+  }
 }

@@ -23,7 +23,6 @@
 #include <Eigen/Core>
 
 #include <concepts>
-#include <initializer_list>
 #include <string>
 #include <type_traits>
 
@@ -79,22 +78,48 @@ constexpr void require_block_size() {
   }
 }
 
+/// Optional member of a block_system: block_jacobian(w, mu), the exact matrix alone, for callers
+/// that need no preconditioning matrix (e.g. one built from the exact Jacobian), saving its assembly.
+template <class S>
+concept has_exact_block_jacobian = block_system<S> && requires(const S& s, const vec<double>& w, double mu) {
+  { s.block_jacobian(w, mu) } -> std::same_as<block_sparse_matrix<double, S::block_size>>;
+};
+
+namespace internal {
+template <int B>
+void check_block_jacobian_size(const block_sparse_matrix<double, B>& m, Eigen::Index n, const char* which,
+                               const std::string& who) {
+  const Eigen::Index padded = padded_block_count(n, B) * B;
+  require(m.rows() == padded && m.cols() == padded && m.logical_rows() == n && m.logical_cols() == n, who, ": ", which,
+          " block Jacobian is ", m.logical_rows(), "x", m.logical_cols(), " (padded ", m.rows(), "x", m.cols(),
+          "), system has ", n, " unknowns (padded ", padded, ")");
+}
+}  // namespace internal
+
 /// The model's pair at (w, mu), checked: both matrices square with the padded size of the system
 /// and logical size size() (a model's own assembly is plain data; a wrong size would otherwise
 /// surface as an out-of-range access in the Krylov solver). who names the caller in the message.
 template <block_system S>
 block_jacobian_pair<S::block_size> checked_jacobians(const S& sys, const vec<double>& w, double mu,
                                                      const std::string& who) {
-  constexpr int B = S::block_size;
-  block_jacobian_pair<B> p = sys.jacobians(w, mu);
-  const Eigen::Index padded = padded_block_count(sys.size(), B) * B;
-  for (const auto* m : {&p.exact, &p.preconditioning})
-    require(m->rows() == padded && m->cols() == padded && m->logical_rows() == sys.size() &&
-                m->logical_cols() == sys.size(),
-            who, ": ", m == &p.exact ? "exact" : "preconditioning", " block Jacobian is ", m->logical_rows(), "x",
-            m->logical_cols(), " (padded ", m->rows(), "x", m->cols(), "), system has ", sys.size(),
-            " unknowns (padded ", padded, ")");
+  block_jacobian_pair<S::block_size> p = sys.jacobians(w, mu);
+  internal::check_block_jacobian_size(p.exact, sys.size(), "exact", who);
+  internal::check_block_jacobian_size(p.preconditioning, sys.size(), "preconditioning", who);
   return p;
+}
+
+/// The exact matrix alone, checked like checked_jacobians: block_jacobian(w, mu) if the model
+/// has it (has_exact_block_jacobian), else jacobians(w, mu).exact.
+template <block_system S>
+block_sparse_matrix<double, S::block_size> checked_exact_jacobian(const S& sys, const vec<double>& w, double mu,
+                                                                  const std::string& who) {
+  if constexpr (has_exact_block_jacobian<S>) {
+    block_sparse_matrix<double, S::block_size> a = sys.block_jacobian(w, mu);
+    internal::check_block_jacobian_size(a, sys.size(), "exact", who);
+    return a;
+  } else {
+    return checked_jacobians(sys, w, mu, who).exact;
+  }
 }
 
 }  // namespace aerohopf
