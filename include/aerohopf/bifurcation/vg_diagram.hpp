@@ -18,9 +18,9 @@
 // each mode takes the candidate whose TRACKED PART (the structural unknowns of an aeroelastic
 // system: vg_options::tracked_offset / tracked_size) has the largest normalised overlap
 //     |s_prev^H s| / (||s_prev|| ||s||)
-// with its previous one (greedy, largest overlap first). For an aeroelastic_system
+// with its previous one (greedy, largest overlap first); for an aeroelastic_system
 // (nonlinear/aeroelastic_system.hpp) the tracked part is by default its structure_part(v), so
-// any such model is tracked by its structural unknowns without knowing where it keeps them. A mode left without a candidate, or
+// any such model is tracked by its structural unknowns. A mode left without a candidate, or
 // whose overlap is below vg_options::min_overlap, gets one more inverse power from the secant
 // prediction 2 lambda_k(mu_{j-1}) - lambda_k(mu_{j-2}) and the assignment is redone.
 // Eigenpairs with (almost) no tracked part are no candidates (vg_options::min_tracked_share).
