@@ -3,7 +3,8 @@
 // do not), the compile-time block-size check (block_system_of as a constraint, require_block_size
 // in a constant expression), the aerofoil's jacobians() pair against its single block
 // assemblies and its Eigen sparse Jacobians bit for bit, and the size checks of
-// checked_jacobians / checked_exact_jacobian.
+// checked_jacobians / checked_exact_jacobian. (That a mismatch in require_block_size stops the
+// build is the CTest compile_fail_block_size_mismatch, tests/compile_fail/.)
 #include <gtest/gtest.h>
 
 #include <aerohopf/flow/naca_cgrid.hpp>
