@@ -1,6 +1,7 @@
 // V-g / V-f diagram (bifurcation/vg_diagram.hpp): mode tracking by the eigenvector through a
 // frequency crossing and the flutter point, against the closed form and a dense
-// eigen-decomposition of a two-mode linear system; on the heavy very coarse aerofoil, the zero
+// eigen-decomposition of a two-mode linear system (also as an aeroelastic_system, tracked by
+// its structural part by default); on the heavy very coarse aerofoil, the zero
 // crossing of g against the Hopf point of the augmented-system Newton solve.
 #include <aerohopf/bifurcation/hopf.hpp>
 #include <aerohopf/bifurcation/root_locus.hpp>
@@ -194,6 +195,62 @@ TEST(vg_diagram, solver_and_solver_factory_overloads) {
     EXPECT_LT(std::abs(a.points[i].lambda - ref.points[i].lambda), 1e-12);
     EXPECT_LT(std::abs(b.points[i].lambda - ref.points[i].lambda), 1e-10);
   }
+}
+
+namespace {
+// The two-mode system with its lag states first: w' = (w_4, w_5, w_0 .. w_3), A' = P A P^T. As an
+// aeroelastic_system (2 "flow", 4 structural unknowns) its structural part is the tracked part
+// of two_mode_options, found from the concept without offsets. claimed_flow: a layout that does
+// not add up to size().
+struct two_mode_aeroelastic {
+  using jacobian_type = Eigen::MatrixXd;
+  Eigen::Index claimed_flow = 2;
+  static Eigen::MatrixXd p() {
+    Eigen::MatrixXd m = Eigen::MatrixXd::Zero(6, 6);
+    for (int i = 0; i < 6; ++i) m(i, (i + 4) % 6) = 1;
+    return m;
+  }
+  Eigen::Index size() const { return 6; }
+  vec<double> residual(const vec<double>& w, double mu) const { return jacobian(w, mu) * w; }
+  jacobian_type jacobian(const vec<double>&, double mu) const { return p() * two_mode_system::a(mu) * p().transpose(); }
+  Eigen::Index flow_size() const { return claimed_flow; }
+  Eigen::Index structure_size() const { return 4; }
+  template <class T>
+  vec<T> structure_part(const vec<T>& v) const {
+    require_size(v.size(), 6, "two_mode_aeroelastic::structure_part", "vector");
+    return v.tail(4);
+  }
+};
+static_assert(aeroelastic_system<two_mode_aeroelastic> && !aeroelastic_system<two_mode_system>);
+}  // namespace
+
+// An aeroelastic_system is tracked by its structure_part with the default tracked range: the
+// same modes and flutter point as the explicit range of the unpermuted system, the 4-entry
+// in-vacuo-like start shapes accepted (the whole vector would need 6), a bad layout refused.
+TEST(vg_diagram, aeroelastic_system_is_tracked_by_its_structural_part_by_default) {
+  const two_mode_aeroelastic sys;
+  const std::vector<double> mus = grid(0.05, 0.2, 10);
+  vg_options o;
+  o.inverse_power.max_iterations = 500;
+  ASSERT_EQ(o.tracked_offset, 0);
+  ASSERT_EQ(o.tracked_size, 0);
+  const double mu0 = mus.front();
+  const std::vector<vg_mode_start> starts{{cplx(0, 1.9), two_mode_system::eigenvector(0, mu0).head(4)},
+                                          {cplx(0, 1.1), two_mode_system::eigenvector(1, mu0).head(4)}};
+  const vg_result r = vg_diagram(sys, zero_state, mus, starts, o);
+  const vg_result ref = vg_diagram(two_mode_system{}, zero_state, mus, starts, two_mode_options());
+  ASSERT_EQ(r.points.size(), ref.points.size());
+  for (std::size_t i = 0; i < r.points.size(); ++i) {
+    EXPECT_EQ(r.points[i].mode, ref.points[i].mode);
+    EXPECT_LT(std::abs(r.points[i].lambda - two_mode_system::lambda(r.points[i].mode, r.points[i].mu)), 1e-10);
+    EXPECT_NEAR(r.points[i].overlap, ref.points[i].overlap, 1e-9);
+  }
+  ASSERT_EQ(r.flutter.size(), 1u);
+  EXPECT_EQ(r.flutter[0].mode, 1);
+  EXPECT_NEAR(r.flutter[0].mu, ref.flutter[0].mu, 1e-9);
+  two_mode_aeroelastic bad;
+  bad.claimed_flow = 3;
+  EXPECT_THROW(vg_diagram(bad, zero_state, mus, starts, o), input_error);
 }
 
 TEST(vg_diagram, refuses_bad_input_with_context) {

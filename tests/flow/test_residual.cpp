@@ -1,10 +1,12 @@
 // Euler residual: free-stream preservation on deformed, moving multi-block grids (2D C-grid
 // topology with wake cut, 3D two-block box); uniform flow along a moving slip wall; a block
 // split with a reversed interface gives the same residual as the single block; double, dd_real
-// and taylor<> evaluations agree.
+// and taylor<> evaluations agree; set_free_stream gives the bits of a model built with that free
+// stream (residuals, Jacobians) without rebuilding grid, metrics or halos, and refuses bad input.
 #include <gtest/gtest.h>
 
 #include <aerohopf/flow/euler_model.hpp>
+#include <aerohopf/flow/jacobian.hpp>
 #include <aerohopf/flow/naca_cgrid.hpp>
 #include <aerohopf/scalar.hpp>
 
@@ -365,6 +367,99 @@ TEST(euler_residual, set_grid_motion_refuses_mismatched_grids_and_keeps_the_mode
   EXPECT_EQ(m.grid().points.blocks.size(), full.blocks.size());
   const vec<double> r1 = m.residual(w);
   EXPECT_EQ((r1 - r0).cwiseAbs().maxCoeff(), 0.0);
+}
+
+// set_free_stream changes only the free stream: a model built at M = 0.6 and set to (M = 0.85,
+// alpha = 0.02) gives the same bits as one built there (residuals in double and taylor<>,
+// both Jacobians, forces, spectral radius), on the rest grid and on a moved one, and its grid,
+// metrics and halos are the same objects (their storage is not reallocated: nothing rebuilt).
+TEST(euler_residual, set_free_stream_in_place_equals_a_model_built_with_it) {
+  const auto grid = coarsen(naca_cgrid(), 8);
+  const free_stream target{.mach = 0.85, .alpha_rad = 0.02};
+  euler_model<2> changed(grid, {.mach = 0.6, .alpha_rad = 0.0});
+  const euler_model<2> built(grid, target);
+  const auto* points = changed.grid().points.blocks[0].x.data();
+  const auto* volumes = changed.metrics().blocks[1].volume.data();
+  const auto* normals = changed.metrics().blocks[2].normal[0].data();
+  const auto* halos = changed.halos().data();
+  changed.set_free_stream(target);
+  EXPECT_EQ(changed.conditions().mach, target.mach);
+  EXPECT_EQ(changed.conditions().alpha_rad, target.alpha_rad);
+  EXPECT_EQ(changed.grid().points.blocks[0].x.data(), points);
+  EXPECT_EQ(changed.metrics().blocks[1].volume.data(), volumes);
+  EXPECT_EQ(changed.metrics().blocks[2].normal[0].data(), normals);
+  EXPECT_EQ(changed.halos().data(), halos);
+
+  auto same_bits = [](const euler_model<2>& a, const euler_model<2>& b, const char* where) {
+    SCOPED_TRACE(where);
+    vec<double> w = b.free_stream_vector();
+    EXPECT_EQ(a.free_stream_vector(), w);
+    for (Eigen::Index k = 0; k < w.size(); ++k) w[k] *= 1.0 + 0.02 * std::sin(0.37 * double(k));
+    EXPECT_EQ(a.residual(w), b.residual(w));
+    using J = taylor<double, 1>;
+    vec<J> wj(w.size());
+    for (Eigen::Index k = 0; k < w.size(); ++k) wj[k] = J::variable(w[k], std::cos(0.11 * double(k)));
+    const vec<J> ra = a.residual(wj), rb = b.residual(wj);
+    for (Eigen::Index k = 0; k < w.size(); ++k) {
+      ASSERT_EQ(ra[k][0], rb[k][0]) << k;
+      ASSERT_EQ(ra[k][1], rb[k][1]) << k;
+    }
+    for (const auto kind : {jacobian_kind::exact, jacobian_kind::modified_order}) {
+      block_sparse_matrix<double, 4> ja, jb;
+      assemble_jacobian<2>(a, w, kind, ja);
+      assemble_jacobian<2>(b, w, kind, jb);
+      EXPECT_EQ(ja.col_index(), jb.col_index());
+      EXPECT_EQ(ja.values(), jb.values());
+    }
+    const auto fa = a.forces(w), fb = b.forces(w);
+    EXPECT_EQ(fa.cl, fb.cl);
+    EXPECT_EQ(fa.cd, fb.cd);
+    EXPECT_EQ(fa.cm, fb.cm);
+    EXPECT_EQ(a.spectral_radius(w), b.spectral_radius(w));
+  };
+  same_bits(changed, built, "rest grid");
+  // a moved grid (the aerofoil's Jacobian assembly moves a copy of the model)
+  auto moved = grid.points;
+  auto speeds = grid.points;
+  for (auto& b : moved.blocks)
+    for (auto& x : b.x) x = {x[0] * std::cos(0.01) - x[1] * std::sin(0.01), x[0] * std::sin(0.01) + x[1] * std::cos(0.01)};
+  for (auto& b : speeds.blocks)
+    for (auto& x : b.x) x = {-0.05 * x[1], 0.05 * x[0]};
+  euler_model<2> moved_changed(grid, {.mach = 0.5});
+  moved_changed.set_grid_motion(moved, &speeds);
+  moved_changed.set_free_stream(target);
+  euler_model<2> moved_built(grid, target);
+  moved_built.set_grid_motion(moved, &speeds);
+  same_bits(moved_changed, moved_built, "moved grid");
+  // and back: the first free stream again gives the first model's bits
+  changed.set_free_stream({.mach = 0.6, .alpha_rad = 0.0});
+  same_bits(changed, euler_model<2>(grid, {.mach = 0.6, .alpha_rad = 0.0}), "set back");
+}
+
+// A Mach number that is not positive and finite, or a non-finite angle: refused by
+// set_free_stream (naming it and the value) and by the constructor; the model keeps its free
+// stream and gives the same residual bits.
+TEST(euler_residual, set_free_stream_refuses_bad_conditions_and_keeps_the_model) {
+  auto m = small_cgrid_model();
+  const free_stream before = m.conditions();
+  vec<double> w = m.free_stream_vector();
+  for (Eigen::Index k = 0; k < w.size(); ++k) w[k] *= 1.0 + 0.01 * std::sin(0.37 * double(k));
+  const vec<double> r0 = m.residual(w);
+  const double inf = std::numeric_limits<double>::infinity(), nan = std::nan("");
+  for (const double mach : {0.0, -0.5, nan, inf}) {
+    SCOPED_TRACE(mach);
+    EXPECT_TRUE(contains(input_error_of([&] { m.set_free_stream({.mach = mach}); }),
+                         "euler_model::set_free_stream: Mach number"));
+    EXPECT_THROW(euler_model<2>(m.grid(), {.mach = mach}), input_error);
+  }
+  EXPECT_TRUE(contains(input_error_of([&] { m.set_free_stream({.mach = 0.7, .alpha_rad = nan}); }), "angle of attack"));
+  EXPECT_TRUE(contains(input_error_of([&] { m.set_free_stream({.mach = 0.7, .alpha_rad = 0.0, .beta_rad = inf}); }),
+                       "angle of sideslip"));
+  EXPECT_THROW(euler_model<2>(m.grid(), {.mach = 0.7, .alpha_rad = inf}), input_error);
+  EXPECT_EQ(m.conditions().mach, before.mach);
+  EXPECT_EQ(m.conditions().alpha_rad, before.alpha_rad);
+  EXPECT_EQ(m.conditions().beta_rad, before.beta_rad);
+  EXPECT_EQ(m.residual(w), r0);
 }
 
 // Negative density, negative pressure, NaN and Inf in one cell: refused by the residual in

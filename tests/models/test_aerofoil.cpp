@@ -4,7 +4,8 @@
 // flow block, the analytic d_mu / A_mu against jets and differences in Ubar, the loads against
 // the flow solver's own force integration, and the symmetric equilibrium (steady flow at
 // alpha = 0, zero structural state) with zero residual for every Ubar; the contact smoothing
-// that makes the residual three times differentiable there (dd differences vs taylor<>).
+// that makes the residual three times differentiable there (dd differences vs taylor<>); the
+// Mach number and incidence set in place give the bits of a system built with them.
 #include <gtest/gtest.h>
 
 #include <aerohopf/flow/naca_cgrid.hpp>
@@ -17,6 +18,7 @@
 #include <array>
 #include <cmath>
 #include <iostream>
+#include <limits>
 #include <random>
 
 using namespace aerohopf;
@@ -27,6 +29,8 @@ static_assert(dynamical_system<aerofoil_system>);
 static_assert(has_approximate_jacobian<aerofoil_system>);
 static_assert(has_d_mu<aerofoil_system>);
 static_assert(has_jacobian_d_mu<aerofoil_system>);
+static_assert(block_system_of<aerofoil_system, 4>);
+static_assert(aeroelastic_system<aerofoil_system>);
 
 namespace {
 
@@ -341,4 +345,47 @@ TEST(aerofoil_system, residual_and_loads_refuse_non_finite_and_wrongly_sized_sta
   EXPECT_NE(message([&] { s.approximate_block_jacobian(short_w, 1.0); }).find("aerofoil_system::approximate_jacobian"),
             std::string::npos);
   EXPECT_NE(message([&] { s.block_jacobians(short_w, 1.0); }).find("aerofoil_system::jacobian"), std::string::npos);
+}
+
+// set_mach / set_free_stream change the free stream in place: a system built at M = 0.6 and set
+// to M = 0.85 gives the same bits as one built at 0.85 (residual, both block Jacobians, loads,
+// parameter derivatives), the flow model's grid, metrics and halos are the same objects (their
+// storage is not reallocated), and bad conditions are refused with the system unchanged.
+TEST(aerofoil_system, set_mach_in_place_equals_a_system_built_at_that_mach) {
+  auto changed = make_system(0.6);
+  const auto* points = changed.flow().grid().points.blocks[0].x.data();
+  const auto* volumes = changed.flow().metrics().blocks[1].volume.data();
+  const auto* halos = changed.flow().halos().data();
+  auto same_bits = [](const aerofoil_system& a, const aerofoil_system& b, const char* where) {
+    SCOPED_TRACE(where);
+    EXPECT_EQ(a.free_stream_state(), b.free_stream_state());
+    const vec<double> w = perturbed_state(b, 9);
+    const double mu = 2.5;
+    EXPECT_EQ(a.residual<double>(w, mu), b.residual<double>(w, mu));
+    const auto pa = a.jacobians(w, mu), pb = b.jacobians(w, mu);
+    EXPECT_EQ(pa.exact.col_index(), pb.exact.col_index());
+    EXPECT_EQ(pa.exact.values(), pb.exact.values());
+    EXPECT_EQ(pa.preconditioning.values(), pb.preconditioning.values());
+    EXPECT_EQ(a.load_coefficients<double>(w), b.load_coefficients<double>(w));
+    EXPECT_EQ(a.d_mu(w, mu), b.d_mu(w, mu));
+  };
+  changed.set_mach(0.85);
+  EXPECT_EQ(changed.flow().conditions().mach, 0.85);
+  same_bits(changed, make_system(0.85), "set_mach");
+  EXPECT_EQ(changed.flow().grid().points.blocks[0].x.data(), points);
+  EXPECT_EQ(changed.flow().metrics().blocks[1].volume.data(), volumes);
+  EXPECT_EQ(changed.flow().halos().data(), halos);
+  // the incidence too (the lift direction of the loads follows it)
+  const flow::free_stream inclined{.mach = 0.7, .alpha_rad = 0.02};
+  changed.set_free_stream(inclined);
+  same_bits(changed, aerofoil_system(euler_model<2>(coarsen(naca_cgrid(), 8), inclined), structure::pitch_plunge{}),
+            "set_free_stream");
+  // refused: the system keeps its free stream and its bits
+  const vec<double> w = perturbed_state(changed, 10);
+  const vec<double> r0 = changed.residual<double>(w, 2.0);
+  for (const double mach : {0.0, -0.7, std::nan(""), std::numeric_limits<double>::infinity()}) EXPECT_THROW(changed.set_mach(mach), input_error) << mach;
+  EXPECT_THROW(changed.set_free_stream({.mach = 0.7, .alpha_rad = std::nan("")}), input_error);
+  EXPECT_EQ(changed.flow().conditions().mach, inclined.mach);
+  EXPECT_EQ(changed.flow().conditions().alpha_rad, inclined.alpha_rad);
+  EXPECT_EQ(changed.residual<double>(w, 2.0), r0);
 }

@@ -18,7 +18,9 @@
 // each mode takes the candidate whose TRACKED PART (the structural unknowns of an aeroelastic
 // system: vg_options::tracked_offset / tracked_size) has the largest normalised overlap
 //     |s_prev^H s| / (||s_prev|| ||s||)
-// with its previous one (greedy, largest overlap first). A mode left without a candidate, or
+// with its previous one (greedy, largest overlap first); for an aeroelastic_system
+// (nonlinear/aeroelastic_system.hpp) the tracked part is by default its structure_part(v), so
+// any such model is tracked by its structural unknowns. A mode left without a candidate, or
 // whose overlap is below vg_options::min_overlap, gets one more inverse power from the secant
 // prediction 2 lambda_k(mu_{j-1}) - lambda_k(mu_{j-2}) and the assignment is redone.
 // Eigenpairs with (almost) no tracked part are no candidates (vg_options::min_tracked_share).
@@ -60,6 +62,7 @@
 #include <vector>
 
 #include "../error.hpp"
+#include "../nonlinear/aeroelastic_system.hpp"
 #include "../nonlinear/system.hpp"
 #include "inverse_power.hpp"
 
@@ -72,8 +75,12 @@ struct vg_mode_start {
 
 struct vg_options {
   inverse_power_options inverse_power{};
-  Eigen::Index tracked_offset = 0;  ///< first entry of the part of the eigenvector that identifies a mode
-  Eigen::Index tracked_size = 0;    ///< its length; 0: through the last entry (the whole vector by default)
+  /// The part of the eigenvector that identifies a mode: entries [tracked_offset, tracked_offset +
+  /// tracked_size). Both 0 (the default): the structural part (structure_part) of an
+  /// aeroelastic_system, the whole vector of any other system. tracked_size 0 with an offset:
+  /// through the last entry.
+  Eigen::Index tracked_offset = 0;
+  Eigen::Index tracked_size = 0;
   double min_overlap = 0.9;         ///< a step whose best overlap is below this is halved
   int max_subdivisions = 4;         ///< halvings of one listed step (down to 1/16 of it)
   /// An eigenpair whose tracked part is below this share of the (unit) eigenvector is no
@@ -222,9 +229,22 @@ vg_result vg_trace(const S& sys, const Equilibrium& equilibrium, const std::vect
   require(!starts.empty(), who, ": no modes to trace (starts is empty)");
   require(opt.tracked_offset >= 0 && opt.tracked_offset < n, who, ": tracked_offset ", opt.tracked_offset,
           " outside the state of ", n, " entries");
-  const Eigen::Index ts = opt.tracked_size > 0 ? opt.tracked_size : n - opt.tracked_offset;
-  require(opt.tracked_offset + ts <= n, who, ": tracked part [", opt.tracked_offset, ", ", opt.tracked_offset + ts,
-          ") outside the state of ", n, " entries");
+  [[maybe_unused]] bool structural = false;  // the tracked part is sys.structure_part(v)
+  if constexpr (aeroelastic_system<S>) {
+    if (opt.tracked_offset == 0 && opt.tracked_size == 0) {
+      check_aeroelastic_layout(sys, who);
+      structural = true;
+    }
+  }
+  Eigen::Index offset = opt.tracked_offset, ts = opt.tracked_size > 0 ? opt.tracked_size : n - opt.tracked_offset;
+  if constexpr (aeroelastic_system<S>) {
+    if (structural) {
+      offset = sys.flow_size();
+      ts = sys.structure_size();
+    }
+  }
+  require(offset + ts <= n, who, ": tracked part [", offset, ", ", offset + ts, ") outside the state of ", n,
+          " entries");
   require(opt.min_overlap >= 0 && opt.min_overlap <= 1, who, ": min_overlap = ", opt.min_overlap, " outside [0, 1]");
   require(opt.min_tracked_share >= 0 && opt.min_tracked_share < 1, who, ": min_tracked_share = ", opt.min_tracked_share,
           " outside [0, 1)");
@@ -245,7 +265,12 @@ vg_result vg_trace(const S& sys, const Equilibrium& equilibrium, const std::vect
   vg_result res;
   res.modes = m;
   std::vector<std::vector<vg_point>> by_mode(m);
-  auto part = [&](const vec<C>& v) { return vec<C>(v.segment(opt.tracked_offset, ts)); };
+  auto part = [&](const vec<C>& v) {
+    if constexpr (aeroelastic_system<S>) {
+      if (structural) return vec<C>(sys.structure_part(v));
+    }
+    return vec<C>(v.segment(offset, ts));
+  };
 
   struct candidate {
     eigen_pair ep;
@@ -323,7 +348,7 @@ vg_result vg_trace(const S& sys, const Equilibrium& equilibrium, const std::vect
       vec<C> start;
       if (have_reference) {
         start = vec<C>::Zero(n);
-        start.segment(opt.tracked_offset, ts) = starts[k].tracked;
+        start.segment(offset, ts) = starts[k].tracked;  // the structural part is the last ts entries
       }
       solve(a, w, mu, starts[k].shift, have_reference ? &start : nullptr, cand);
     }

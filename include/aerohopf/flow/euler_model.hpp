@@ -122,7 +122,7 @@ class euler_model {
   euler_model(multiblock_grid<Dim> grid, free_stream fs, euler_options opt = {})
       : grid_(std::move(grid)), fs_(fs), opt_(opt) {
     require(opt_.order == 1 || opt_.order == 2, "euler_model: order ", opt_.order, " must be 1 or 2");
-    require(fs_.mach > 0.0 && std::isfinite(fs_.mach), "euler_model: Mach number ", fs_.mach, " must be positive");
+    check_free_stream(fs_, "euler_model");
     require(grid_.topology.cells.size() == grid_.points.blocks.size(), "euler_model: topology has ",
             grid_.topology.cells.size(), " blocks, grid has ", grid_.points.blocks.size());
     for (std::size_t b = 0; b < grid_.points.blocks.size(); ++b)
@@ -158,6 +158,18 @@ class euler_model {
       const auto p = unravel<Dim>(h.face, metrics_.blocks[h.block].face_dims(h.dir));
       far_centre_[h.patch_face] = internal::face_centre<double, Dim>(grid_.points.blocks[h.block], h.dir, p);
     }
+  }
+
+  /// Sets the free stream (Mach number, angles) in place: grid, metrics, halos and layout do not
+  /// depend on it and are kept (a family of models over Mach shares them; rebuilding costs more
+  /// than a residual on the NACA 0012 grids). Nothing derived from the free stream is cached:
+  /// free-stream states, far-field states and p_inf are computed from conditions() where used,
+  /// so the model is then the same, bit for bit, as one constructed with fs. The circulation of
+  /// the far-field vortex (set_circulation) is a separate parameter and is kept. Validated like
+  /// the constructor (Mach positive and finite, angles finite); on refusal the model is unchanged.
+  void set_free_stream(const free_stream& fs) {
+    check_free_stream(fs, "euler_model::set_free_stream");
+    fs_ = fs;
   }
 
   /// Circulation of the far-field point vortex (used with options().vortex_far_field).
@@ -598,6 +610,12 @@ class euler_model {
   }
 
  private:
+  static void check_free_stream(const free_stream& fs, std::string_view who) {
+    require(fs.mach > 0.0 && std::isfinite(fs.mach), who, ": Mach number ", fs.mach, " must be positive and finite");
+    require(std::isfinite(fs.alpha_rad), who, ": angle of attack ", fs.alpha_rad, " rad is not finite");
+    require(std::isfinite(fs.beta_rad), who, ": angle of sideslip ", fs.beta_rad, " rad is not finite");
+  }
+
   bool tagged(int patch) const {
     return opt_.force_tag.empty() || grid_.topology.patches[patch].tag == opt_.force_tag;
   }

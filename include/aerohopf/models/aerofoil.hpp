@@ -22,6 +22,10 @@
 //          structural unknown; exact, includes the dependence of the loads on the moved geometry),
 //   A_sf: derivative of the wall-pressure integrals by a local jet per wall cell.
 // d_mu and jacobian_d_mu are analytic: -M^{-1} dK/dUbar w_s and the 4x4 block -M^{-1} dK/dUbar.
+// Concepts met: block_system (block_size 4: jacobians() gives the exact and the modified-order
+// matrices in 4 x 4 blocks, the structural unknowns the last block) and aeroelastic_system
+// (flow part first, the 4 structural unknowns last). The Mach number (free stream) is set in
+// place by set_mach / set_free_stream: the grid, metrics, halos and wall faces are kept.
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
 
@@ -37,7 +41,10 @@
 #include "../flow/jacobian.hpp"
 #include "../flow/metrics.hpp"
 #include "../flow/steady_solver.hpp"
+#include "../linalg/block_sparse_matrix.hpp"
 #include "../linalg/direct.hpp"
+#include "../nonlinear/aeroelastic_system.hpp"
+#include "../nonlinear/block_system.hpp"
 #include "../nonlinear/system.hpp"
 #include "../scalar/jet.hpp"
 #include "../scalar/taylor.hpp"
@@ -50,6 +57,7 @@ class aerofoil_system {
   using jacobian_type = Eigen::SparseMatrix<double>;
   static constexpr int n_structure = 4;
   static constexpr int nv = 4;
+  static constexpr int block_size = nv;  // block_system: one flow cell per block, the structure one block
 
   /// flow: the Euler model on the rest grid (free stream, options; its wall patches with
   /// options().force_tag, or all walls if empty, carry the loads); structure: the section.
@@ -85,8 +93,27 @@ class aerofoil_system {
 
   Eigen::Index size() const { return nf_ + n_structure; }
   Eigen::Index flow_size() const { return nf_; }
+  Eigen::Index structure_size() const { return n_structure; }
+  /// The structural unknowns (h, h', alpha, alpha') of a state or eigenvector (the last 4 entries).
+  template <class T>
+  vec<T> structure_part(const vec<T>& v) const {
+    require_size(v.size(), size(), "aerofoil_system::structure_part", "vector");
+    return v.tail(n_structure);
+  }
   const flow::euler_model<2>& flow() const { return flow_; }
   const structure::pitch_plunge& structure() const { return structure_; }
+
+  /// A new free stream (Mach number, incidence) in place: the flow model's grid, metrics and
+  /// halos and this system's wall faces do not depend on it and are kept, so the system is then
+  /// the same as one constructed with fs, without the set-up (euler_model::set_free_stream).
+  /// Refused (input_error) like the constructor's; the system is then unchanged.
+  void set_free_stream(const flow::free_stream& fs) { flow_.set_free_stream(fs); }
+  /// The same with only the Mach number changed.
+  void set_mach(double mach) {
+    flow::free_stream fs = flow_.conditions();
+    fs.mach = mach;
+    set_free_stream(fs);
+  }
 
   /// Uniform free stream with the section at rest (the start of the steady solve).
   vec<double> free_stream_state() const {
@@ -179,23 +206,32 @@ class aerofoil_system {
   }
 
   jacobian_type jacobian(const vec<double>& w, double mu) const { return assemble(w, mu, flow::jacobian_kind::exact); }
-  /// The exact Jacobian in 4 x 4 blocks (the structural unknowns are the last block row and
-  /// column; no padding): what solve_hopf_krylov takes directly when a system offers it, saving
-  /// the Eigen round trip (triplets, sort, re-blocking: about half the assembly time, measured).
+  /// block_system: the exact Jacobian and the modified-order one (the preconditioning matrix) in
+  /// 4 x 4 blocks (the structural unknowns are the last block row and column; no padding), what
+  /// the Krylov path takes directly, saving the Eigen round trip (triplets, sort, re-blocking:
+  /// about half the assembly time). The coupling blocks (A_fs, A_ss, A_sf) are the same in the
+  /// two and are computed once (one jet<double, 4> pass of the whole residual: about a seventh
+  /// of the assembly time on the medium grid, measured).
+  block_jacobian_pair<block_size> jacobians(const vec<double>& w, double mu) const {
+    constexpr const char* who = "aerofoil_system::jacobians";
+    block_jacobian_pair<block_size> p{assemble_blocks(w, mu, flow::jacobian_kind::exact, nullptr, who),
+                                      block_sparse_matrix<double, nv>()};
+    p.preconditioning = assemble_blocks(w, mu, flow::jacobian_kind::modified_order, &p.exact, who);
+    return p;
+  }
+  /// The exact Jacobian alone in blocks (jacobians().exact, without the modified-order one).
   block_sparse_matrix<double, nv> block_jacobian(const vec<double>& w, double mu) const {
     return assemble_blocks(w, mu, flow::jacobian_kind::exact);
   }
+  /// The modified-order Jacobian alone in blocks (jacobians().preconditioning).
   block_sparse_matrix<double, nv> approximate_block_jacobian(const vec<double>& w, double mu) const {
     return assemble_blocks(w, mu, flow::jacobian_kind::modified_order);
   }
-  /// Both at once: the coupling blocks (A_fs, A_ss, A_sf) are the same in the two and are
-  /// computed once (one jet<double, 4> pass of the whole residual: about a seventh of the assembly
-  /// time on the medium grid, measured).
+  /// jacobians() as (exact, approximate).
   std::pair<block_sparse_matrix<double, nv>, block_sparse_matrix<double, nv>> block_jacobians(const vec<double>& w,
                                                                                               double mu) const {
-    auto exact = assemble_blocks(w, mu, flow::jacobian_kind::exact);
-    auto approximate = assemble_blocks(w, mu, flow::jacobian_kind::modified_order, &exact);
-    return {std::move(exact), std::move(approximate)};
+    auto p = jacobians(w, mu);
+    return {std::move(p.exact), std::move(p.preconditioning)};
   }
   /// Same with the modified-order flow block (left-hand side of Newton iterations).
   jacobian_type approximate_jacobian(const vec<double>& w, double mu) const {
@@ -237,8 +273,7 @@ class aerofoil_system {
                                                    : internal::concat(", structural unknown ", i - nf_)));
     }
   }
-  static const char* who_of(flow::jacobian_kind kind, const void* coupling_from) {
-    if (coupling_from) return "aerofoil_system::block_jacobians";
+  static const char* who_of(flow::jacobian_kind kind) {
     return kind == flow::jacobian_kind::exact ? "aerofoil_system::jacobian" : "aerofoil_system::approximate_jacobian";
   }
 
@@ -298,8 +333,9 @@ class aerofoil_system {
   /// With coupling_from (a matrix assembled by this function at the same (w, mu)), the coupling
   /// blocks are copied from it instead of computed.
   block_sparse_matrix<double, nv> assemble_blocks(const vec<double>& w, double mu, flow::jacobian_kind kind,
-                                                  const block_sparse_matrix<double, nv>* coupling_from = nullptr) const {
-    check_state(*this, w, mu, who_of(kind, coupling_from));
+                                                  const block_sparse_matrix<double, nv>* coupling_from = nullptr,
+                                                  const char* who = nullptr) const {
+    check_state(*this, w, mu, who ? who : who_of(kind));
     using sidx = block_sparse_matrix<double, nv>::storage_index;
     // A_ff on the moved grid.
     const vec<double> wf = w.head(nf_);

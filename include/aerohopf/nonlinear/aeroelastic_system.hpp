@@ -1,0 +1,61 @@
+#pragma once
+// aeroelastic_system: a dynamical_system (system.hpp) whose state is a flow part followed by a
+// structural part bordered onto it,
+//     w = [w_f (flow_size() entries), w_s (structure_size() entries)],  size() = their sum.
+//
+// Why a concept of its own: the structural unknowns are what identifies an aeroelastic mode.
+// The flow part of an eigenvector is no test of "the same mode" (a moving shock rotates it far
+// from its neighbour's on one branch), its structural part is; so the mode test of natural
+// continuation in a second parameter, the V-g tracking and the flutter-boundary driver compare
+// structural parts, and with this concept they do it for any model (aerofoil, wing) instead of
+// knowing where a particular model keeps them.
+//
+// A model provides, besides dynamical_system:
+//   Eigen::Index flow_size() const;        // entries of the flow part (first)
+//   Eigen::Index structure_size() const;   // entries of the structural part (last, > 0)
+//   template <class T> vec<T> structure_part(const vec<T>& v) const;
+//       // the structural entries of a state or eigenvector v of size() entries, in any scalar
+//       // (double states, complex eigenvectors); refuses a v of another size.
+#include <Eigen/Core>
+
+#include <complex>
+#include <concepts>
+#include <string>
+
+#include "../error.hpp"
+#include "system.hpp"
+
+namespace aerohopf {
+
+template <class S>
+concept aeroelastic_system =
+    dynamical_system<S> &&
+    requires(const S& s, const vec<double>& w, const vec<std::complex<double>>& z) {
+      { s.flow_size() } -> std::convertible_to<Eigen::Index>;
+      { s.structure_size() } -> std::convertible_to<Eigen::Index>;
+      { s.structure_part(w) } -> std::convertible_to<vec<double>>;
+      { s.structure_part(z) } -> std::convertible_to<vec<std::complex<double>>>;
+    };
+
+/// Throws input_error unless the layout is [flow, structure] with structure_size() > 0,
+/// flow_size() >= 0 and flow_size() + structure_size() == size() (who names the caller).
+template <aeroelastic_system S>
+void check_aeroelastic_layout(const S& s, const std::string& who) {
+  const Eigen::Index nf = s.flow_size(), ns = s.structure_size(), n = s.size();
+  require(nf >= 0 && ns > 0 && nf + ns == n, who, ": aeroelastic layout of ", nf, " flow and ", ns,
+          " structural entries does not make up the system's ", n, " unknowns");
+}
+
+/// |s_a^H s_b| / (||s_a|| ||s_b||) of the structural parts of two vectors (states or
+/// eigenvectors) of the system: the mode test, 1 for the same structural shape up to a complex
+/// factor. 0 if either structural part is zero.
+template <aeroelastic_system S, class T>
+double structural_overlap(const S& s, const vec<T>& a, const vec<T>& b) {
+  const vec<T> sa = s.structure_part(a), sb = s.structure_part(b);
+  const double na = sa.norm(), nb = sb.norm();
+  if (!(na > 0) || !(nb > 0)) return 0.0;
+  using std::abs;
+  return abs(sa.dot(sb)) / (na * nb);
+}
+
+}  // namespace aerohopf
