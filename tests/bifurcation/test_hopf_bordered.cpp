@@ -421,6 +421,12 @@ TEST(hopf_bordered_full, second_derivative_product_matches_differenced_jacobians
   EXPECT_LT((b - aerohopf::internal::second_derivative_product(sp, w, mu, v, u)).norm(), 1e-13 * b.norm());
   EXPECT_GT(b.norm(), 1e-3);
   EXPECT_EQ(aerohopf::internal::second_derivative_product(sp, w, mu, u, vec<double>(vec<double>::Zero(4))).norm(), 0.0);
+  // the differenced pair (jet<double, 2> Jacobian products at w +- h v) against the exact one
+  const auto [dr, di] = aerohopf::internal::second_derivative_pair(sp, w, mu, u, w, v, false);
+  const auto [er, ei] = aerohopf::internal::second_derivative_pair(sp, w, mu, u, w, v, true);
+  EXPECT_LT((dr - b).norm(), 1e-8 * b.norm());
+  EXPECT_LT((er - b).norm(), 1e-14 * b.norm());
+  EXPECT_LT((di - ei).norm(), 1e-8 * ei.norm());
 }
 
 // The small system with w*(mu) = c mu: the full Krylov solve lands on the known Hopf point
@@ -436,25 +442,29 @@ TEST(hopf_bordered_full, small_moving_equilibrium_krylov_matches_lu) {
   EXPECT_GT(info.linear_iterations, 0);
   EXPECT_NEAR(std::abs(g.p.dot(g0.p)), 1.0, 1e-8);  // the same unit eigenvector up to phase
   const hopf_result lu = solve_hopf(sp, g, full_options());
-  hopf_options vo = full_options();
-  vo.verbose = true;
-  vo.label = "full krylov (small)";
-  const hopf_result kr = solve_hopf_krylov<2>(sp, g, vo, full_krylov());
-  ASSERT_TRUE(kr.report.converged);
-  EXPECT_NEAR(kr.point.mu, 1.0, 1e-10);
-  EXPECT_NEAR(kr.point.omega, 2.0, 1e-10);
-  EXPECT_LT((kr.point.w - sp.equilibrium(1.0)).norm(), 1e-10);
-  EXPECT_NEAR(kr.point.mu, lu.point.mu, 1e-12);
-  EXPECT_NEAR(kr.point.omega, lu.point.omega, 1e-12);
-  EXPECT_LT((kr.point.w - lu.point.w).norm(), 1e-10);
-  EXPECT_GT(kr.linear_iterations, 0);
-  EXPECT_LE(kr.report.iterations, lu.report.iterations + 1);
-  EXPECT_GE(kr.report.iterations, 3);
-  const auto& h = kr.report.residual_history;
-  for (std::size_t k = 1; k + 1 < h.size(); ++k)
-    if (h[k] < 1e-2 && h[k + 1] > 1e-12) {
-      EXPECT_LT(h[k + 1], 10 * h[k] * h[k] + 1e-2 * h[k]) << "step " << k;
-    }
+  for (const bool exact : {false, true}) {
+    hopf_options vo = full_options();
+    vo.verbose = true;
+    vo.label = exact ? "full krylov (small, exact B)" : "full krylov (small)";
+    hopf_krylov_options ko = full_krylov();
+    ko.exact_second_derivatives = exact;
+    const hopf_result kr = solve_hopf_krylov<2>(sp, g, vo, ko);
+    ASSERT_TRUE(kr.report.converged);
+    EXPECT_NEAR(kr.point.mu, 1.0, 1e-10);
+    EXPECT_NEAR(kr.point.omega, 2.0, 1e-10);
+    EXPECT_LT((kr.point.w - sp.equilibrium(1.0)).norm(), 1e-10);
+    EXPECT_NEAR(kr.point.mu, lu.point.mu, 1e-12);
+    EXPECT_NEAR(kr.point.omega, lu.point.omega, 1e-12);
+    EXPECT_LT((kr.point.w - lu.point.w).norm(), 1e-10);
+    EXPECT_GT(kr.linear_iterations, 0);
+    EXPECT_LE(kr.report.iterations, lu.report.iterations + 1);
+    EXPECT_GE(kr.report.iterations, 3);
+    const auto& h = kr.report.residual_history;
+    for (std::size_t k = 1; k + 1 < h.size(); ++k)
+      if (h[k] < 1e-2 && h[k + 1] > 1e-12) {
+        EXPECT_LT(h[k + 1], 10 * h[k] * h[k] + 1e-2 * h[k]) << "step " << k;
+      }
+  }
   // the fixed-equilibrium Krylov solve of the same guess is refused by its post-check
   hopf_options fixed = fixed_options();
   fixed.newton.throw_on_failure = false;
@@ -478,20 +488,20 @@ TEST(hopf_bordered_full, full_formulation_hostile_input) {
   hopf_point bad = g;
   bad.w[1] = NAN;
   EXPECT_THROW(solve_hopf_krylov<2>(sp, bad, full_options(), full_krylov()), input_error);
-  // a NaN residual inside the run (call 25: 3 calls per residual of F, 9 per step with f_mu and
-  // the four second-derivative products, so the residual at iterate 2): the last accepted
-  // iterate is named, or returned
+  // a NaN residual inside the run (call 17: 3 calls per residual of F, 5 per step with f_mu and
+  // the four differenced second-derivative passes, so the residual at iterate 2): the last
+  // accepted iterate is named, or returned
   hopf_options o = full_options();
   o.label = "injected full";
   try {
-    solve_hopf_krylov<2>(faulty_system(sp, 25), g, o, full_krylov());
+    solve_hopf_krylov<2>(faulty_system(sp, 17), g, o, full_krylov());
     ADD_FAILURE() << "no exception";
   } catch (const convergence_error& e) {
     EXPECT_NE(std::string(e.what()).find("last accepted iterate"), std::string::npos) << e.what();
     EXPECT_NE(std::string(e.what()).find("injected full"), std::string::npos) << e.what();
   }
   o.newton.throw_on_failure = false;
-  const hopf_result r = solve_hopf_krylov<2>(faulty_system(sp, 25), g, o, full_krylov());
+  const hopf_result r = solve_hopf_krylov<2>(faulty_system(sp, 17), g, o, full_krylov());
   EXPECT_FALSE(r.report.converged);
   EXPECT_TRUE(r.point.w.allFinite() && r.point.p.allFinite());
   // hopf_start_krylov input checks
@@ -554,6 +564,14 @@ double pitch(const aerofoil_system& s, const vec<double>& w) { return w[s.flow_s
 TEST(hopf_bordered_full, incidence_krylov_full_matches_lu_full) {
   const auto& f = incidence();
   const hopf_point &k = f.krylov.point, &l = f.lu.point;
+  {
+    hopf_krylov_options ko = full_krylov();
+    ko.exact_second_derivatives = true;
+    const hopf_result e = solve_hopf_krylov<4>(f.s, f.start, full_options(), ko);
+    EXPECT_NEAR(e.point.mu, l.mu, 1e-8 * l.mu);
+    EXPECT_NEAR(e.point.omega, l.omega, 1e-8 * l.omega);
+    EXPECT_EQ(e.report.iterations, f.krylov.report.iterations);
+  }
   std::cout << "alpha_0 = 1 deg: LU Ubar* " << std::setprecision(12) << l.mu << " omega* " << l.omega << " ("
             << f.lu.report.iterations << " Newton); Krylov " << k.mu << " " << k.omega << " ("
             << f.krylov.report.iterations << " Newton, " << f.krylov.linear_iterations << " GMRES); static pitch "
