@@ -7,6 +7,7 @@
 // solve_hopf_krylov converges. Bad input is refused with a clear error.
 #include <gtest/gtest.h>
 
+#include <aerohopf/bifurcation/equilibrium_krylov.hpp>
 #include <aerohopf/bifurcation/hopf.hpp>
 #include <aerohopf/bifurcation/hopf_bordered.hpp>
 #include <aerohopf/flow/naca_cgrid.hpp>
@@ -14,8 +15,11 @@
 
 #include "support/hopf_test_systems.hpp"
 
+#include <Eigen/Eigenvalues>
+
 #include <complex>
 #include <cstdlib>
+#include <iomanip>
 #include <iostream>
 
 using namespace aerohopf;
@@ -374,4 +378,272 @@ TEST(hopf_bordered_hostile, krylov_options_are_checked) {
   short_w.w = vec<double>::Zero(2);
   EXPECT_THROW(solve_hopf_krylov<2>(sp, short_w, o), input_error);
   EXPECT_THROW(solve_hopf_bordered(d, short_w, o, lu), input_error);
+}
+
+// ---- the full formulation (hopf_krylov_options::full_system: [w, p_r, p_i, mu, omega], the
+// equilibrium moving with mu) and the Krylov inverse-power start (hopf_start_krylov) ----
+namespace {
+hopf_options full_options(double tol = 1e-10) {
+  hopf_options o;
+  o.symmetric = false;
+  o.newton.abs_tolerance = tol;
+  return o;
+}
+/// A guess off the equilibrium branch (w of mu = 0.7 moved off it) with the eigenvector there.
+hopf_point far_guess(const sparse_sys& sp) {
+  hopf_point g = hopf_start(sp, sp.equilibrium(0.7), 0.7, 1.7);
+  vec<double> d(4);
+  d << 1.0, -1.0, 1.0, 0.5;
+  g.w += 0.05 * d;
+  return g;
+}
+hopf_krylov_options full_krylov(int fill = 1) {
+  hopf_krylov_options k;
+  k.full_system = true;
+  k.fill_level = fill;
+  return k;
+}
+}  // namespace
+
+// The second-derivative product B(u, v) = (A_w u) v by taylor<double, 2> polarisation against
+// central differences of the assembled Jacobian (system.hpp's jacobian_directional), and its
+// symmetry.
+TEST(hopf_bordered_full, second_derivative_product_matches_differenced_jacobians) {
+  const sparse_sys sp(moving_c);
+  vec<double> w(4), u(4), v(4);
+  w << 0.3, -0.2, 0.5, 0.1;
+  u << 1.0, -0.4, 0.3, 0.8;
+  v << -0.2, 0.9, 0.5, -0.6;
+  const double mu = 0.7;
+  const vec<double> b = aerohopf::internal::second_derivative_product(sp, w, mu, u, v);
+  const vec<double> fd = jacobian_directional(sp, w, mu, u) * v;
+  EXPECT_LT((b - fd).norm(), 1e-8 * fd.norm()) << b.transpose() << " vs " << fd.transpose();
+  EXPECT_LT((b - aerohopf::internal::second_derivative_product(sp, w, mu, v, u)).norm(), 1e-13 * b.norm());
+  EXPECT_GT(b.norm(), 1e-3);
+  EXPECT_EQ(aerohopf::internal::second_derivative_product(sp, w, mu, u, vec<double>(vec<double>::Zero(4))).norm(), 0.0);
+  // the differenced pair (jet<double, 2> Jacobian products at w +- h v) against the exact one
+  const auto [dr, di] = aerohopf::internal::second_derivative_pair(sp, w, mu, u, w, v, false);
+  const auto [er, ei] = aerohopf::internal::second_derivative_pair(sp, w, mu, u, w, v, true);
+  EXPECT_LT((dr - b).norm(), 1e-8 * b.norm());
+  EXPECT_LT((er - b).norm(), 1e-14 * b.norm());
+  EXPECT_LT((di - ei).norm(), 1e-8 * ei.norm());
+}
+
+// The small system with w*(mu) = c mu: the full Krylov solve lands on the known Hopf point
+// (mu* = 1, omega* = 2, w* = c) and on the full sparse-LU solve (solve_hopf), quadratically,
+// with the equilibrium part moved from the guess's mu; hopf_start_krylov equals hopf_start.
+TEST(hopf_bordered_full, small_moving_equilibrium_krylov_matches_lu) {
+  const sparse_sys sp(moving_c);
+  const hopf_point g0 = far_guess(sp);
+  eigen_pair info;
+  hopf_point g = hopf_start_krylov<2>(sp, sp.equilibrium(0.7), 0.7, 1.7, {}, &info);
+  g.w = g0.w;
+  EXPECT_NEAR(g.omega, g0.omega, 1e-8);
+  EXPECT_GT(info.linear_iterations, 0);
+  EXPECT_NEAR(std::abs(g.p.dot(g0.p)), 1.0, 1e-8);  // the same unit eigenvector up to phase
+  const hopf_result lu = solve_hopf(sp, g, full_options());
+  for (const bool exact : {false, true}) {
+    hopf_options vo = full_options();
+    vo.verbose = true;
+    vo.label = exact ? "full krylov (small, exact B)" : "full krylov (small)";
+    hopf_krylov_options ko = full_krylov();
+    ko.exact_second_derivatives = exact;
+    const hopf_result kr = solve_hopf_krylov<2>(sp, g, vo, ko);
+    ASSERT_TRUE(kr.report.converged);
+    EXPECT_NEAR(kr.point.mu, 1.0, 1e-10);
+    EXPECT_NEAR(kr.point.omega, 2.0, 1e-10);
+    EXPECT_LT((kr.point.w - sp.equilibrium(1.0)).norm(), 1e-10);
+    EXPECT_NEAR(kr.point.mu, lu.point.mu, 1e-12);
+    EXPECT_NEAR(kr.point.omega, lu.point.omega, 1e-12);
+    EXPECT_LT((kr.point.w - lu.point.w).norm(), 1e-10);
+    EXPECT_GT(kr.linear_iterations, 0);
+    EXPECT_LE(kr.report.iterations, lu.report.iterations + 1);
+    EXPECT_GE(kr.report.iterations, 3);
+    const auto& h = kr.report.residual_history;
+    for (std::size_t k = 1; k + 1 < h.size(); ++k)
+      if (h[k] < 1e-2 && h[k + 1] > 1e-12) {
+        EXPECT_LT(h[k + 1], 10 * h[k] * h[k] + 1e-2 * h[k]) << "step " << k;
+      }
+  }
+  // the fixed-equilibrium Krylov solve of the same guess is refused by its post-check
+  hopf_options fixed = fixed_options();
+  fixed.newton.throw_on_failure = false;
+  const hopf_result sym = solve_hopf_krylov<2>(sp, g, fixed);
+  EXPECT_FALSE(sym.report.converged);
+  EXPECT_NE(sym.report.reason.find("equilibrium does not hold at mu*"), std::string::npos) << sym.report.reason;
+}
+
+TEST(hopf_bordered_full, full_formulation_hostile_input) {
+  const sparse_sys sp(moving_c);
+  const hopf_point g = far_guess(sp);
+  ASSERT_GE(solve_hopf_krylov<2>(sp, g, full_options(), full_krylov()).report.iterations, 3);
+  EXPECT_THROW(solve_hopf_krylov<2>(sp, g, full_options()), input_error);  // full_system not set
+  EXPECT_THROW(solve_hopf_krylov<2>(sp, g, fixed_options(), full_krylov()), input_error);  // symmetric set
+  hopf_krylov_options k = full_krylov();
+  k.start_iterations = 1;
+  EXPECT_THROW(solve_hopf_krylov<2>(sp, g, full_options(), k), input_error);
+  k = full_krylov();
+  k.fill_level = -2;
+  EXPECT_THROW(solve_hopf_krylov<2>(sp, g, full_options(), k), input_error);
+  hopf_point bad = g;
+  bad.w[1] = NAN;
+  EXPECT_THROW(solve_hopf_krylov<2>(sp, bad, full_options(), full_krylov()), input_error);
+  // a NaN residual inside the run (call 17: 3 calls per residual of F, 5 per step with f_mu and
+  // the four differenced second-derivative passes, so the residual at iterate 2): the last
+  // accepted iterate is named, or returned
+  hopf_options o = full_options();
+  o.label = "injected full";
+  try {
+    solve_hopf_krylov<2>(faulty_system(sp, 17), g, o, full_krylov());
+    ADD_FAILURE() << "no exception";
+  } catch (const convergence_error& e) {
+    EXPECT_NE(std::string(e.what()).find("last accepted iterate"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("injected full"), std::string::npos) << e.what();
+  }
+  o.newton.throw_on_failure = false;
+  const hopf_result r = solve_hopf_krylov<2>(faulty_system(sp, 17), g, o, full_krylov());
+  EXPECT_FALSE(r.report.converged);
+  EXPECT_TRUE(r.point.w.allFinite() && r.point.p.allFinite());
+  // hopf_start_krylov input checks
+  EXPECT_THROW(hopf_start_krylov<2>(sp, vec<double>(vec<double>::Zero(3)), 0.9, 1.9), input_error);
+  EXPECT_THROW(hopf_start_krylov<2>(sp, sp.equilibrium(0.9), 0.9, NAN), input_error);
+  hopf_start_krylov_options so;
+  so.inverse_power.max_iterations = 0;
+  EXPECT_THROW(hopf_start_krylov<2>(sp, sp.equilibrium(0.9), 0.9, 1.9, so), input_error);
+  so = {};
+  so.inverse_power.max_iterations = 1;
+  so.inverse_power.tolerance = 1e-14;
+  EXPECT_THROW(hopf_start_krylov<2>(sp, sp.equilibrium(0.9), 0.9, 1.9, so), convergence_error);
+}
+
+// ---- the NACA 0012 pitch-plunge at a mean incidence alpha_0 = 1 deg (very coarse grid, light
+// case, M = 0.5): the steady flow lifts and pitches the section, so the equilibrium (its static
+// pitch and plunge deflection) depends on Ubar and only the full formulation applies ----
+namespace {
+constexpr double alpha0 = 1.0 * 3.14159265358979323846 / 180.0;
+
+aerofoil_system make_incidence(int stride, double mach) {
+  structure::pitch_plunge_parameters p;
+  p.mu_s = 10;
+  return aerofoil_system(euler_model<2>(coarsen(naca_cgrid(), stride), {.mach = mach, .alpha_rad = alpha0}),
+                         structure::pitch_plunge(p));
+}
+
+struct incidence_fixture {
+  aerofoil_system s = make_incidence(8, 0.5);
+  // the steady flow with the section at rest (loaded: not an equilibrium of the coupled system)
+  vec<double> rest = s.steady_equilibrium({}, INFINITY);
+  /// The static aeroelastic equilibrium at ubar: Newton-Krylov on the coupled system from w0.
+  vec<double> static_equilibrium(double ubar, const vec<double>& w0) const {
+    equilibrium_krylov_options eo;
+    eo.newton.abs_tolerance = 1e-11;
+    // full Newton steps: from the loaded rest state the first step raises ||f|| 100x (the
+    // deflection it jumps to, alpha = 1.6 deg at Ubar = 1.75, exceeds alpha_0) and the halving
+    // line search crawls instead (measured: ||f|| 0.030 -> 0.025 in 20 iterations; 6 without)
+    eo.newton.line_search = false;
+    return solve_equilibrium_krylov<4>(s, ubar, w0, eo, "static aeroelastic solve").w;
+  }
+  vec<double> w_guess = static_equilibrium(1.75, rest);
+  hopf_point start = hopf_start_krylov<4>(s, w_guess, 1.75, 0.6);
+  hopf_result lu = solve_hopf(s, start, full_options());
+  hopf_result krylov = [this] {
+    hopf_options o = full_options();
+    o.verbose = true;
+    o.label = "full krylov, alpha_0 = 1 deg";
+    return solve_hopf_krylov<4>(s, start, o, full_krylov());
+  }();
+};
+
+const incidence_fixture& incidence() {
+  static const incidence_fixture f;
+  return f;
+}
+double pitch(const aerofoil_system& s, const vec<double>& w) { return w[s.flow_size() + 2]; }
+}  // namespace
+
+TEST(hopf_bordered_full, incidence_krylov_full_matches_lu_full) {
+  const auto& f = incidence();
+  const hopf_point &k = f.krylov.point, &l = f.lu.point;
+  {
+    hopf_krylov_options ko = full_krylov();
+    ko.exact_second_derivatives = true;
+    const hopf_result e = solve_hopf_krylov<4>(f.s, f.start, full_options(), ko);
+    EXPECT_NEAR(e.point.mu, l.mu, 1e-8 * l.mu);
+    EXPECT_NEAR(e.point.omega, l.omega, 1e-8 * l.omega);
+    EXPECT_EQ(e.report.iterations, f.krylov.report.iterations);
+  }
+  std::cout << "alpha_0 = 1 deg: LU Ubar* " << std::setprecision(12) << l.mu << " omega* " << l.omega << " ("
+            << f.lu.report.iterations << " Newton); Krylov " << k.mu << " " << k.omega << " ("
+            << f.krylov.report.iterations << " Newton, " << f.krylov.linear_iterations << " GMRES); static pitch "
+            << pitch(f.s, k.w) << " rad at Ubar*, " << pitch(f.s, f.w_guess) << " at 1.75\n";
+  ASSERT_TRUE(f.krylov.report.converged);
+  EXPECT_NEAR(k.mu, l.mu, 1e-8 * l.mu);
+  EXPECT_NEAR(k.omega, l.omega, 1e-8 * l.omega);
+  EXPECT_LT((k.w - l.w).norm(), 1e-7 * l.w.norm());
+  EXPECT_LT(eigen_residual(f.s, k), 1e-9);
+  EXPECT_LE(f.krylov.report.iterations, 7);
+  // the deflection is real and moves with Ubar (else the fixed-equilibrium system would do)
+  EXPECT_GT(std::abs(pitch(f.s, k.w)), 1e-4);
+  EXPECT_GT(std::abs(pitch(f.s, k.w) - pitch(f.s, f.w_guess)), 1e-3 * std::abs(pitch(f.s, k.w)));
+}
+
+// A static aeroelastic solve at Ubar* from the loaded rest state gives the equilibrium part of
+// the Hopf point, the structural deflection in particular.
+TEST(hopf_bordered_full, incidence_equilibrium_is_the_static_aeroelastic_solution) {
+  const auto& f = incidence();
+  const hopf_point& k = f.krylov.point;
+  const vec<double> ws = f.static_equilibrium(k.mu, f.rest);
+  std::cout << "static solve at Ubar*: pitch " << std::setprecision(12) << pitch(f.s, ws) << ", Hopf point "
+            << pitch(f.s, k.w) << "\n";
+  EXPECT_NEAR(pitch(f.s, ws), pitch(f.s, k.w), 1e-8 * std::abs(pitch(f.s, k.w)));
+  const auto n = f.s.flow_size();
+  EXPECT_LT((ws.tail(4) - k.w.tail(4)).norm(), 1e-8 * k.w.tail(4).norm());
+  EXPECT_LT((ws.head(n) - k.w.head(n)).norm(), 1e-8 * k.w.head(n).norm());
+}
+
+// The dense spectrum of A at the static equilibrium of Ubar* - 0.01, Ubar*, Ubar* + 0.01: the
+// critical pair crosses the imaginary axis at Ubar* (real part through zero, imaginary part
+// omega*), every other eigenvalue stays in the left half-plane.
+TEST(hopf_bordered_full, incidence_dense_spectrum_crosses_at_the_hopf_point) {
+  const auto& f = incidence();
+  const hopf_point& k = f.krylov.point;
+  double re[3];
+  int i = 0;
+  for (double d : {-0.01, 0.0, 0.01}) {
+    const vec<double> w = d == 0.0 ? k.w : f.static_equilibrium(k.mu + d, k.w);
+    Eigen::EigenSolver<Eigen::MatrixXd> es(Eigen::MatrixXd(f.s.jacobian(w, k.mu + d)), false);
+    const auto& ev = es.eigenvalues();
+    Eigen::Index best = 0;
+    for (Eigen::Index j = 1; j < ev.size(); ++j)
+      if (std::abs(ev[j] - cplx(0, k.omega)) < std::abs(ev[best] - cplx(0, k.omega))) best = j;
+    double other = -1e300;
+    for (Eigen::Index j = 0; j < ev.size(); ++j)
+      if (std::abs(ev[j] - ev[best]) > 1e-9 && std::abs(ev[j] - std::conj(ev[best])) > 1e-9)
+        other = std::max(other, ev[j].real());
+    std::cout << "Ubar* " << std::showpos << d << std::noshowpos << ": critical " << ev[best] << ", others <= " << other
+              << "\n";
+    re[i++] = ev[best].real();
+    EXPECT_LT(other, 0.0);
+    if (d == 0.0) {
+      EXPECT_NEAR(ev[best].imag(), k.omega, 1e-8);
+    }
+  }
+  EXPECT_LT(re[0], 0.0);
+  EXPECT_GT(re[2], 0.0);
+  EXPECT_LT(std::abs(re[1]), 1e-8);
+  EXPECT_LT(std::abs(re[1]), 1e-4 * std::min(-re[0], re[2]));
+}
+
+// The fixed-equilibrium formulation is refused here: the Krylov solver without full_system
+// (input_error), and with hopf_options::symmetric by its post-check, as the equilibrium of
+// Ubar = 1.75 does not hold at the Ubar it converges to.
+TEST(hopf_bordered_full, incidence_fixed_equilibrium_is_refused) {
+  const auto& f = incidence();
+  EXPECT_THROW(solve_hopf_krylov<4>(f.s, f.start, full_options()), input_error);
+  hopf_options o = full_options();
+  o.symmetric = true;
+  o.newton.throw_on_failure = false;
+  const hopf_result r = solve_hopf_krylov<4>(f.s, f.start, o);
+  EXPECT_FALSE(r.report.converged);
+  EXPECT_NE(r.report.reason.find("equilibrium does not hold at mu*"), std::string::npos) << r.report.reason;
 }

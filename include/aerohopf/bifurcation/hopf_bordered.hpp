@@ -48,10 +48,28 @@
 //   number (4 Newton iterations, ~30 GMRES iterations each), 1.3-1.5 x the steady solve.
 //   Preconditioning with BILU(k) of the EXACT shifted matrix (precondition_exact) needs fewer
 //   GMRES iterations at k = 3 but costs more per Hopf point (2.0 x the steady solve at k = 1..3).
+//
+// Full formulation (hopf_krylov_options::full_system; hopf_options::symmetric = false): the
+// equilibrium moves with mu (an asymmetric section or a mean incidence: the static aeroelastic
+// deflection depends on Ubar), unknowns [w, p_r, p_i, mu, omega] (3n + 2) with the augmented
+// system of hopf.hpp. The flow update is eliminated inside the Newton step: with
+//     A dw0 = -f,   A dw1 = -f_mu   (real GMRES on the exact A, preconditioned by the real BILU(k)
+//                                    of L; A is regular at a Hopf point),
+// dw = dw0 + dmu dw1, and the eigen-equation rows become the fixed-equilibrium bordered system
+// above with the right-hand side -G - (A_w p) dw0 and the mu column A_mu p + (A_w p) dw1, solved
+// by the same bordered GMRES. (A_w p) x = B(p, x) is a second-derivative product
+// (internal::second_derivative_product: the system's jacobian_directional, else two
+// taylor<double, 2> passes, else central differences of Jacobian-vector products; by default
+// central differences of jet<double, 2> Jacobian products, hopf_krylov_options::
+// exact_second_derivatives), four per step. So a Newton step costs two real and one bordered complex BILU-GMRES solve plus one
+// assembly and two factorisations: about a fixed-equilibrium step plus two steady Newton steps.
+// The three solves share the inexact-Newton forcing; F is exact, so the converged point is.
 #include <Eigen/Core>
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
+#include <limits>
 #include <complex>
 #include <concepts>
 #include <iomanip>
@@ -65,13 +83,29 @@
 #include "../linalg/block_sparse_matrix.hpp"
 #include "../linalg/direct.hpp"
 #include "../linalg/krylov.hpp"
+#include "../linalg/operator.hpp"
 #include "../nonlinear/newton.hpp"
 #include "../nonlinear/system.hpp"
+#include "../scalar/jet.hpp"
+#include "../scalar/taylor.hpp"
 #include "hopf.hpp"
 
 namespace aerohopf {
 
 namespace internal {
+
+/// Progress line per Newton iteration of a Hopf solve with N unknowns, mu and omega last (with
+/// the running linear-iteration count); only with opt.verbose and no observer of the caller's.
+inline void add_hopf_progress(newton_options& nopt, const hopf_options& opt, Eigen::Index N,
+                              const long& linear_iterations) {
+  if (!opt.verbose || !opt.log || nopt.observer) return;
+  std::ostream& os = *opt.log;
+  nopt.observer = [&os, label = opt.label, N, &linear_iterations](const newton_step_info& i) {
+    os << label << " it " << std::setw(2) << i.iteration << "  |F| " << std::scientific << std::setprecision(3)
+       << i.residual << "  mu " << std::setprecision(12) << std::defaultfloat << (*i.x)[N - 2] << "  omega "
+       << (*i.x)[N - 1] << "  linear its " << linear_iterations << (i.relaxation < 1 ? "  (relaxed)" : "") << "\n";
+  };
+}
 
 /// Unknowns y = [p_r, p_i, mu, omega] of the symmetric Hopf system, with its exact residual
 /// (matrix-free) and the unpacking of the converged point; shared by the bordered solvers.
@@ -109,13 +143,7 @@ struct symmetric_hopf_problem {
 
   /// Progress line per Newton iteration (with the running linear-iteration count).
   void add_progress(newton_options& nopt, const hopf_options& opt, const long& linear_iterations) const {
-    if (!opt.verbose || !opt.log || nopt.observer) return;
-    std::ostream& os = *opt.log;
-    nopt.observer = [&os, label = opt.label, N = N, &linear_iterations](const newton_step_info& i) {
-      os << label << " it " << std::setw(2) << i.iteration << "  |F| " << std::scientific << std::setprecision(3)
-         << i.residual << "  mu " << std::setprecision(12) << std::defaultfloat << (*i.x)[N - 2] << "  omega "
-         << (*i.x)[N - 1] << "  linear its " << linear_iterations << (i.relaxation < 1 ? "  (relaxed)" : "") << "\n";
-    };
+    add_hopf_progress(nopt, opt, N, linear_iterations);
   }
 
   /// The converged point with omega > 0, after the post-checks of hopf.hpp (w is fixed: the
@@ -381,6 +409,19 @@ struct hopf_krylov_options {
   /// grid (light case): continued guesses have ||F|| = 3-7 at subsonic Mach numbers, where Newton
   /// needs 3-4 iterations without the refinement and it does not pay, and 37-280 at transonic ones.
   double start_residual_threshold = 0.0;
+  /// The FULL Hopf system (3n + 2 unknowns [w, p_r, p_i, mu, omega], the equilibrium moving with
+  /// mu: hopf_options::symmetric must be false) instead of the fixed-equilibrium one, solved by
+  /// eliminating the flow update dw inside the same bordered Krylov solve ("Full formulation" in
+  /// the file comment). Matrices and both BILU factorisations are then refreshed at every Newton
+  /// iterate (reuse_matrices and reuse_window do not apply: A moves with w), and the start
+  /// refinement is not available (start_iterations must be 0).
+  bool full_system = false;
+  /// Full formulation: the second-derivative products (A_w p) dw exact (eight taylor<double, 2>
+  /// passes per Newton step) or, by default, central differences of Jacobian products (four
+  /// jet<double, 2> passes, O(h^2); internal::second_derivative_pair). F stays exact either way,
+  /// and so does the converged point (measured on the NACA 0012 coarse grid at alpha_0 = 1 deg,
+  /// M = 0.5 and 0.8: the same Newton and GMRES counts, 30 % less time per Hopf point).
+  bool exact_second_derivatives = false;
 };
 
 namespace internal {
@@ -405,6 +446,242 @@ inline void check_hopf_krylov_options(const hopf_krylov_options& k, const std::s
   require(std::isfinite(k.start_residual_threshold) && k.start_residual_threshold >= 0, where,
           ": start_residual_threshold must be finite and >= 0 (got ", k.start_residual_threshold, ")");
 }
+
+/// B(u, v) = (A_w u) v = d/de [A(w + e v) u] at e = 0 (the second-derivative product of the full
+/// Hopf Jacobian): the system's jacobian_directional if it has one; else exact by polarisation
+/// of two taylor<double, 2> residual passes, B(u, v) = |u||v|/4 [B(a + b, a + b) - B(a - b, a - b)]
+/// with the unit directions a = u/|u|, b = v/|v|; else central differences of exact
+/// Jacobian-vector products, [A(w + h v) u - A(w - h v) u] / 2h (O(h^2), h = eps^(1/3) max(1,
+/// ||w||_inf) / ||v||_inf), which changes only the rate of Newton's convergence.
+template <dynamical_system S>
+vec<double> second_derivative_product(const S& sys, const vec<double>& w, double mu, const vec<double>& u,
+                                      const vec<double>& v) {
+  using T2 = taylor<double, 2>;
+  const double nu = u.norm(), nv = v.norm();
+  if (nu == 0 || nv == 0) return vec<double>::Zero(w.size());
+  if constexpr (has_jacobian_directional<S>) {
+    return vec<double>(jacobian_directional(sys, w, mu, u) * v);
+  } else if constexpr (system_over<S, T2>) {
+    auto b_vv = [&](const vec<double>& d) {
+      vec<T2> wj(w.size());
+      for (Eigen::Index i = 0; i < w.size(); ++i) wj[i] = T2::variable(w[i], d[i]);
+      const vec<T2> fj = sys.residual(wj, T2(mu));
+      vec<double> r(fj.size());
+      for (Eigen::Index i = 0; i < fj.size(); ++i) r[i] = 2.0 * fj[i][2];
+      return r;
+    };
+    const vec<double> a = u / nu, b = v / nv;
+    return (0.25 * nu * nv) * (b_vv(vec<double>(a + b)) - b_vv(vec<double>(a - b)));
+  } else {
+    const double h = std::cbrt(Eigen::NumTraits<double>::epsilon()) *
+                     std::max(1.0, w.template lpNorm<Eigen::Infinity>()) / v.template lpNorm<Eigen::Infinity>();
+    return (jacobian_product(sys, vec<double>(w + h * v), mu, u) - jacobian_product(sys, vec<double>(w - h * v), mu, u)) /
+           (2 * h);
+  }
+}
+
+/// The pair (B(p_r, x), B(p_i, x)) of the full Newton step. exact: second_derivative_product
+/// twice; else central differences of the Jacobian products along x, [A(w + h x) - A(w - h x)]
+/// [p_r, p_i] / 2h with h = eps^(1/3) max(1, ||w||_inf) / ||x||_inf: one jet<double, 2> residual
+/// pass per side when the residual takes jets (about a quarter of the cost of the four taylor<
+/// double, 2> passes), O(h^2) accurate, which changes only the rate of Newton's convergence.
+template <dynamical_system S>
+std::pair<vec<double>, vec<double>> second_derivative_pair(const S& sys, const vec<double>& w, double mu,
+                                                          const vec<double>& pr, const vec<double>& pi,
+                                                          const vec<double>& x, bool exact) {
+  using J2 = jet<double, 2>;
+  const Eigen::Index n = w.size();
+  const double xn = x.template lpNorm<Eigen::Infinity>();
+  if (exact || xn == 0 || has_jacobian_directional<S>)
+    return {second_derivative_product(sys, w, mu, pr, x), second_derivative_product(sys, w, mu, pi, x)};
+  const double h = std::cbrt(Eigen::NumTraits<double>::epsilon()) * std::max(1.0, w.template lpNorm<Eigen::Infinity>()) / xn;
+  if constexpr (system_over<S, J2>) {
+    std::pair<vec<double>, vec<double>> r{vec<double>::Zero(n), vec<double>::Zero(n)};
+    for (const double sign : {1.0, -1.0}) {
+      vec<J2> wj(n);
+      for (Eigen::Index i = 0; i < n; ++i) wj[i] = J2::variable(w[i] + sign * h * x[i], {pr[i], pi[i]});
+      const vec<J2> fj = sys.residual(wj, J2(mu));
+      for (Eigen::Index i = 0; i < n; ++i) {
+        r.first[i] += sign * fj[i].derivative(0);
+        r.second[i] += sign * fj[i].derivative(1);
+      }
+    }
+    r.first /= 2 * h;
+    r.second /= 2 * h;
+    return r;
+  } else {
+    const vec<double> wp = w + h * x, wm = w - h * x;
+    return {(jacobian_product(sys, wp, mu, pr) - jacobian_product(sys, wm, mu, pr)) / (2 * h),
+            (jacobian_product(sys, wp, mu, pi) - jacobian_product(sys, wm, mu, pi)) / (2 * h)};
+  }
+}
+
+/// Unknowns y = [w, p_r, p_i, mu, omega] of the full Hopf system (3n + 2), with its exact
+/// residual (matrix-free eigen-equations) and the unpacking of the converged point.
+template <dynamical_system S>
+struct full_hopf_problem {
+  const S& sys;
+  vec<double> s;
+  Eigen::Index n, N;
+
+  full_hopf_problem(const S& system, const hopf_point& guess, const hopf_options& opt, const char* who,
+                    vec<double>& y0)
+      : sys(system), n(system.size()), N(3 * system.size() + 2) {
+    require(!opt.symmetric, who,
+            ": hopf_krylov_options::full_system solves the full formulation (the equilibrium as unknown); "
+            "hopf_options::symmetric must be false");
+    check_hopf_guess(sys, guess, who);
+    check_hopf_options(opt, who);
+    vec<std::complex<double>> p0 = guess.p;
+    s = hopf_normalise(p0, resolve_normalisation<jacobian_t<S>>(opt.normalisation));
+    y0.resize(N);
+    y0.head(n) = guess.w;
+    y0.segment(n, n) = p0.real();
+    y0.segment(2 * n, n) = p0.imag();
+    y0[N - 2] = guess.mu;
+    y0[N - 1] = guess.omega;
+  }
+
+  vec<double> residual(const vec<double>& y) const {
+    const double mu = y[N - 2], om = y[N - 1];
+    const vec<double> w = y.head(n), pr = y.segment(n, n), pi = y.segment(2 * n, n);
+    vec<double> f(N);
+    f.head(n) = sys.residual(w, mu);
+    f.segment(n, n) = jacobian_product(sys, w, mu, pr) + om * pi;
+    f.segment(2 * n, n) = jacobian_product(sys, w, mu, pi) - om * pr;
+    f[N - 2] = s.dot(pr);
+    f[N - 1] = s.dot(pi) - 1.0;
+    return f;
+  }
+
+  /// The converged point with omega > 0, after the post-checks of hopf.hpp (full formulation).
+  hopf_result result(newton_result&& nr, long linear_iterations, const hopf_options& opt) const {
+    hopf_result res;
+    res.s = s;
+    res.report = std::move(nr.report);
+    res.linear_iterations = linear_iterations;
+    const vec<double>& y = nr.x;
+    res.point.w = y.head(n);
+    res.point.mu = y[N - 2];
+    res.point.omega = y[N - 1];
+    res.point.p = vec<std::complex<double>>(n);
+    res.point.p.real() = y.segment(n, n);
+    res.point.p.imag() = y.segment(2 * n, n);
+    if (res.report.converged && res.point.omega < 0) {
+      res.point.omega = -res.point.omega;
+      res.point.p = res.point.p.conjugate().eval();
+    }
+    hopf_accept(sys, res, opt, false);
+    return res;
+  }
+};
+
+/// solve_hopf_krylov with hopf_krylov_options::full_system ("Full formulation", file comment).
+template <int B, dynamical_system S>
+hopf_result solve_hopf_krylov_full(const S& sys, const hopf_point& guess, const hopf_options& opt,
+                                   const hopf_krylov_options& kopt) {
+  using C = std::complex<double>;
+  using clock = std::chrono::steady_clock;
+  auto since = [](clock::time_point t0) { return std::chrono::duration<double>(clock::now() - t0).count(); };
+  vec<double> x;
+  const full_hopf_problem<S> prob(sys, guess, opt, "solve_hopf_krylov (full system)", x);
+  check_hopf_krylov_options(kopt, "solve_hopf_krylov (full system)");
+  require(kopt.start_iterations == 0,
+          "solve_hopf_krylov (full system): the start refinement (hopf_krylov_options::start_iterations = ",
+          kopt.start_iterations, ") is available only in the fixed-equilibrium formulation; set it to 0");
+  const Eigen::Index n = prob.n, N = prob.N;
+  const Eigen::Index padded = padded_block_count(n, B) * B;
+  const vec<double>& s = prob.s;
+  double setup_seconds = 0, linear_seconds = 0, residual_seconds = 0;
+  block_ilu_options io;
+  io.fill_level = kopt.fill_level;
+  io.context = opt.label + ": complex BILU(" + std::to_string(kopt.fill_level) + ") of L - i omega I";
+  block_ilu<C, B> ilu(io);
+  io.context = opt.label + ": real BILU(" + std::to_string(kopt.fill_level) + ") of L (flow update)";
+  block_ilu<double, B> ilu_real(io);
+  auto residual = [&](const vec<double>& y) {
+    const auto t0 = clock::now();
+    vec<double> f = prob.residual(y);
+    residual_seconds += since(t0);
+    return f;
+  };
+  long linear_iterations = 0;
+  internal::hopf_iterate_log last(x, N - 2, N - 1);
+  auto step = [&](const vec<double>& y, const vec<double>& f, int it) {
+    last.record(y, f, it);
+    const double mu = y[N - 2], om = y[N - 1];
+    const vec<double> w = y.head(n), pr = y.segment(n, n), pi = y.segment(2 * n, n);
+    const double fn = f.norm();
+    // A, L, A_mu, f_mu at the iterate and the two BILU factorisations (A moves with w)
+    auto t0 = clock::now();
+    block_sparse_matrix<double, B> a, l;
+    if (kopt.precondition_exact) a = internal::exact_blocks<B>(sys, w, mu, opt.label);
+    else std::tie(a, l) = internal::exact_and_lhs_blocks<B>(sys, w, mu, opt.label);
+    const jacobian_t<S> amu = jacobian_d_mu(sys, w, mu);
+    const vec<double> fmu = residual_d_mu(sys, w, mu);
+    const block_sparse_matrix<double, B>& pm = kopt.precondition_exact ? a : l;
+    ilu.compute(shifted(pm, C(0.0, om)));
+    ilu_real.compute(pm);
+    setup_seconds += since(t0);
+    krylov_options ko = kopt.krylov;
+    if (kopt.adaptive_tolerance) {
+      ko.relative_tolerance =
+          std::min(kopt.eta_max, std::max(std::pow(fn, kopt.forcing_exponent), 0.1 * opt.newton.abs_tolerance / fn));
+    }
+    ko.throw_on_failure = true;
+    // flow update dw = dw0 + dmu dw1 with A dw0 = -f, A dw1 = -f_mu (real BILU-GMRES)
+    t0 = clock::now();
+    auto flow_solve = [&](const vec<double>& b, const char* what) {
+      vec<double> rhs = vec<double>::Zero(padded), d = vec<double>::Zero(padded);
+      rhs.head(n) = b;
+      ko.context = internal::concat(opt.label, ": GMRES on A dw", what, " at Newton iteration ", it);
+      linear_iterations += gmres<double>(a, ilu_real, rhs, d, ko).iterations;
+      return vec<double>(d.head(n));
+    };
+    const vec<double> dw0 = flow_solve(vec<double>(-f.head(n)), "0 = -f");
+    const vec<double> dw1 = flow_solve(vec<double>(-fmu), "1 = -f_mu");
+    linear_seconds += since(t0);
+    // the second-derivative products (A_w p) dw0, (A_w p) dw1
+    t0 = clock::now();
+    const auto [b0r, b0i] = second_derivative_pair(sys, w, mu, pr, pi, dw0, kopt.exact_second_derivatives);
+    const auto [b1r, b1i] = second_derivative_pair(sys, w, mu, pr, pi, dw1, kopt.exact_second_derivatives);
+    residual_seconds += since(t0);
+    // the fixed-equilibrium bordered system with the corrected right-hand side and mu column
+    const internal::real_split_shifted_operator<block_sparse_matrix<double, B>> inner(a, om, n);
+    const internal::complex_preconditioner_split_form<block_ilu<C, B>> inner_pre(ilu, n, padded);
+    Eigen::MatrixXd u(2 * n, 2), vt = Eigen::MatrixXd::Zero(2, 2 * n);
+    u.col(0) << amu * pr + b1r, amu * pi + b1i;
+    u.col(1) << pi, -pr;
+    vt.row(0).head(n) = s.transpose();
+    vt.row(1).tail(n) = s.transpose();
+    const bordered_operator<decltype(inner), double> jop(inner, 2 * n, std::move(u), std::move(vt),
+                                                         Eigen::MatrixXd::Zero(2, 2));
+    const bordered_preconditioner<decltype(inner_pre), double> jpre(jop, inner_pre);
+    vec<double> rhs(2 * n + 2);
+    rhs << -(f.segment(n, n) + b0r), -(f.segment(2 * n, n) + b0i), -f[N - 2], -f[N - 1];
+    vec<double> d = vec<double>::Zero(2 * n + 2);
+    ko.context = internal::concat(opt.label, ": GMRES on the bordered eigen-equations at Newton iteration ", it);
+    t0 = clock::now();
+    linear_iterations += gmres<double>(jop, jpre, rhs, d, ko).iterations;
+    linear_seconds += since(t0);
+    vec<double> dx(N);
+    dx.head(n) = dw0 + d[2 * n] * dw1;
+    dx.segment(n, 2 * n) = d.head(2 * n);
+    dx[N - 2] = d[2 * n];
+    dx[N - 1] = d[2 * n + 1];
+    return dx;
+  };
+  newton_options nopt = opt.newton;
+  add_hopf_progress(nopt, opt, N, linear_iterations);
+  newton_result nr = internal::run_hopf_newton(
+      [&] { return newton_iterate(residual, step, x, nopt, opt.label + " (full Hopf system, BILU-GMRES)"); }, last,
+      opt);
+  hopf_result res = prob.result(std::move(nr), linear_iterations, opt);
+  res.setup_seconds = setup_seconds;
+  res.linear_seconds = linear_seconds;
+  res.residual_seconds = residual_seconds;
+  return res;
+}
 }  // namespace internal
 
 /// Newton on the symmetric Hopf system with the exact bordered matrix, GMRES and the bordered
@@ -416,6 +693,10 @@ template <int B, dynamical_system S>
   requires is_sparse_matrix_v<jacobian_t<S>>
 hopf_result solve_hopf_krylov(const S& sys, const hopf_point& guess, const hopf_options& opt,
                               const hopf_krylov_options& kopt = {}) {
+  if (kopt.full_system) return internal::solve_hopf_krylov_full<B>(sys, guess, opt, kopt);
+  require(opt.symmetric,
+          "solve_hopf_krylov: hopf_options::symmetric = false (the equilibrium moves with mu) needs the full "
+          "formulation: set hopf_krylov_options::full_system (or hopf_options::symmetric for a fixed equilibrium)");
   using C = std::complex<double>;
   using M = jacobian_t<S>;
   vec<double> x;
@@ -566,6 +847,105 @@ hopf_result solve_hopf_krylov(const S& sys, const hopf_point& guess, const hopf_
   res.residual_seconds = residual_seconds;
   res.start_refined = start_refined;
   return res;
+}
+
+/// Options of hopf_start_krylov.
+struct hopf_start_krylov_options {
+  int fill_level = 1;               ///< k of the complex BILU(k) of L - i omega_guess I
+  bool precondition_exact = false;  ///< BILU(k) of the exact A - i omega_guess I instead
+  /// GMRES of each inverse iteration: the solves must be tighter than the eigen-residual target
+  /// (inexact inverse iteration with a fixed tolerance stagnates near it, inverse_power.hpp).
+  krylov_options krylov = [] {
+    krylov_options o;
+    o.relative_tolerance = 1e-9;
+    o.max_iterations = 2000;
+    o.restart = 80;
+    o.record_history = false;
+    return o;
+  }();
+  /// Tolerance and iteration limit of the inverse iteration (a start for the Hopf Newton
+  /// iteration, which converges the pair exactly: 1e-8 is enough).
+  inverse_power_options inverse_power = [] {
+    inverse_power_options o;
+    o.tolerance = 1e-8;
+    return o;
+  }();
+};
+
+/// Start point for the Hopf Newton iteration at CFD sizes: shift-invert inverse power
+/// (inverse_power.hpp) at (w, mu) with the shift sigma = i omega_guess, each solve of
+/// (A - sigma I) y = x by complex GMRES on the exact A (the fused shifted block product),
+/// right-preconditioned by the complex BILU(k) of L - sigma I, L = lhs_jacobian (the modified-
+/// order Jacobian of the aerofoil) or A itself (precondition_exact). The matrices come from the
+/// system's block_jacobians when it has them (has_block_jacobians), else from its sparse
+/// Jacobians. Convergence as inverse_power: ||A x - lambda x||_2 <= max(tolerance max(1,
+/// |lambda|), 100 eps ||A||_inf), ||x||_2 = 1; otherwise convergence_error with the last lambda.
+/// info (optional) receives the eigenpair with its iteration and GMRES counts.
+template <int B, dynamical_system S>
+  requires is_sparse_matrix_v<jacobian_t<S>>
+hopf_point hopf_start_krylov(const S& sys, const vec<double>& w, double mu, double omega_guess,
+                             const hopf_start_krylov_options& o = {}, eigen_pair* info = nullptr) {
+  using C = std::complex<double>;
+  const char* who = "hopf_start_krylov";
+  check_state(sys, w, mu, who);
+  require(std::isfinite(omega_guess), who, ": omega_guess is not finite (", omega_guess, ")");
+  require(o.fill_level >= 0, who, ": fill_level must be >= 0 (got ", o.fill_level, ")");
+  validate_krylov_options(o.krylov, who);
+  require(o.inverse_power.max_iterations >= 1, who, ": inverse_power.max_iterations must be >= 1 (got ",
+          o.inverse_power.max_iterations, ")");
+  require(std::isfinite(o.inverse_power.tolerance) && o.inverse_power.tolerance > 0, who,
+          ": inverse_power.tolerance must be finite and > 0 (got ", o.inverse_power.tolerance, ")");
+  const Eigen::Index n = sys.size();
+  const C sigma(0.0, omega_guess);
+  block_sparse_matrix<double, B> a, l;
+  if (o.precondition_exact) a = internal::exact_blocks<B>(sys, w, mu, who);
+  else std::tie(a, l) = internal::exact_and_lhs_blocks<B>(sys, w, mu, who);
+  double a_norm = 0;  // ||A||_inf over the logical rows, the scale of the attainable residual
+  for (Eigen::Index bi = 0; bi < a.block_rows(); ++bi) {
+    Eigen::Matrix<double, B, 1> sums = Eigen::Matrix<double, B, 1>::Zero();
+    for (auto k = a.row_ptr()[bi]; k < a.row_ptr()[bi + 1]; ++k) sums += a.block_at(k).cwiseAbs().rowwise().sum();
+    for (int r = 0; r < B; ++r)
+      if (bi * B + r < n) a_norm = std::max(a_norm, sums[r]);
+  }
+  block_ilu_options io;
+  io.fill_level = o.fill_level;
+  io.context = internal::concat(who, ": complex BILU(", o.fill_level, ") of ", o.precondition_exact ? "A" : "L",
+                                " - i omega I");
+  block_ilu<C, B> ilu(io);
+  ilu.compute(shifted(o.precondition_exact ? a : l, sigma));
+  const shifted_operator<block_sparse_matrix<double, B>, C> op(a, sigma);
+  const Eigen::Index padded = a.rows();
+  vec<C> x = vec<C>::Zero(padded), y(padded), r(padded);
+  x.head(n) = internal::default_start(n);
+  krylov_options ko = o.krylov;
+  ko.throw_on_failure = true;
+  eigen_pair ep;
+  const double floor = 100 * std::numeric_limits<double>::epsilon() * a_norm;
+  for (int t = 1; t <= o.inverse_power.max_iterations; ++t) {
+    y.setZero();
+    ko.context = internal::concat(who, ": GMRES on A - i omega I (omega ", omega_guess, "), inverse iteration ", t);
+    ep.linear_iterations += gmres<C>(op, ilu, x, y, ko).iterations;
+    const double ny2 = y.head(n).squaredNorm();
+    if (!(ny2 > 0) || !std::isfinite(ny2))
+      throw convergence_error(internal::concat(who, ": iterate ", t, " is zero or not finite"));
+    ep.lambda = sigma + y.head(n).dot(x.head(n)) / ny2;
+    x.head(n) = y.head(n) / std::sqrt(ny2);
+    a.apply_shifted(ep.lambda, x, r);
+    ep.residual = r.head(n).norm();
+    ep.iterations = t;
+    if (o.inverse_power.verbose && o.inverse_power.log)
+      *o.inverse_power.log << who << " it " << t << "  lambda " << ep.lambda << "  residual " << ep.residual << "  GMRES "
+                           << ep.linear_iterations << "\n";
+    if (ep.residual <= std::max(o.inverse_power.tolerance * std::max(1.0, std::abs(ep.lambda)), floor)) {
+      ep.vector = x.head(n);
+      internal::normalise_phase(ep.vector);
+      if (info) *info = ep;
+      return internal::hopf_point_from(w, mu, ep);
+    }
+  }
+  throw convergence_error(internal::concat(who, ": no convergence in ", o.inverse_power.max_iterations,
+                                           " inverse iterations (shift ", sigma, ", last lambda ", ep.lambda,
+                                           ", residual ", ep.residual, ")"));
 }
 
 }  // namespace aerohopf
