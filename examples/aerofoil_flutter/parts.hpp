@@ -83,6 +83,14 @@ inline std::vector<double> mach_list(const options& o) {
   return r;
 }
 
+/// The inverse-power start of the single points (as the boundary driver's first point).
+inline hopf_start_krylov_options start_options(const options& o) {
+  hopf_start_krylov_options so;
+  so.fill_level = o.fill;
+  so.krylov.restart = flutter_boundary_options{}.start_restart;
+  return so;
+}
+
 /// Hopf options of the single points (very coarse check, V-g fallback, reduced model): ||F|| <= 1e-10.
 inline hopf_options point_options(const options& o, const std::string& label) {
   hopf_options ho;
@@ -98,7 +106,7 @@ inline hopf_options point_options(const options& o, const std::string& label) {
 inline std::optional<flutter_boundary_point> single_hopf_point(const options& o, const aerofoil_system& s,
                                                                const steady_result& st, const structural_case& c,
                                                                const std::string& label) {
-  hopf_point guess = hopf_start_krylov<4>(s, st.w, c.ubar_guess, c.omega_guess, o.fill, 50, &std::cout);
+  hopf_point guess = hopf_start_krylov<4>(s, st.w, c.ubar_guess, c.omega_guess, start_options(o));
   guess.mu = c.ubar_guess;
   guess.w = st.w;
   hopf_krylov_options ko;
@@ -131,7 +139,7 @@ inline void spectra_part(const options& o) {
   const auto st = steady(s);
   hopf_options ho = point_options(o, "hopf very coarse");
   ho.verbose = true;
-  const hopf_result h = solve_hopf_krylov<4>(s, hopf_start_krylov<4>(s, st.w, light_case.ubar_guess, light_case.omega_guess, o.fill, 50, &std::cout), ho);
+  const hopf_result h = solve_hopf_krylov<4>(s, hopf_start_krylov<4>(s, st.w, light_case.ubar_guess, light_case.omega_guess, start_options(o)), ho);
   const double ubar = h.point.mu, omega = h.point.omega;
   std::cout << std::setprecision(10) << "very coarse grid (" << s.flow().n_cells() << " cells), light case, M = 0.5: Ubar* = "
             << ubar << ", omega* = " << omega << " (" << h.report.iterations << " Newton iterations)\n";
@@ -442,7 +450,7 @@ inline void reduced_part(const options& o, const boundaries& all) {
   } else {
     std::cout << "  (no " << c.name << " " << g.name << " boundary point at M = " << mach
               << " in this run: inverse-power start)\n";
-    guess = hopf_start_krylov<4>(s, st.w, c.ubar_guess, c.omega_guess, o.fill, 50, &std::cout);
+    guess = hopf_start_krylov<4>(s, st.w, c.ubar_guess, c.omega_guess, start_options(o));
   }
   guess.w = st.w;
   hopf_krylov_options hk;

@@ -260,36 +260,6 @@ double structural_cosine(const F& family, const vec<std::complex<double>>& p0, c
   return std::abs(s0.dot(s1)) / (s0.norm() * s1.norm());
 }
 
-/// Inverse-power start of a Hopf Newton iteration at (w, mu) with shift i omega (spec 02): GMRES
-/// on the exact A - i omega I preconditioned by the complex BILU(k) of the preconditioning
-/// L - i omega I; no sparse LU. GMRES to 1e-9 per solve: inexact inverse iteration stagnates
-/// near the solve tolerance (inverse_power.hpp). The returned guess has mu and omega of the
-/// eigenvalue found.
-template <int B, dynamical_system S>
-hopf_point hopf_start_krylov(const S& s, const vec<double>& w, double mu, double omega, int fill, int restart = 50,
-                             std::ostream* log = nullptr) {
-  using cplx = std::complex<double>;
-  krylov_solver_options ko;
-  ko.fill_level = fill;
-  ko.krylov.relative_tolerance = 1e-9;
-  ko.krylov.max_iterations = 2000;
-  ko.krylov.restart = restart;
-  ko.krylov.record_history = false;
-  ko.krylov.reorthogonalize = false;
-  krylov_solver<Eigen::SparseMatrix<cplx>, B> solver(ko, "inverse power, complex BILU-GMRES");
-  solver.precondition_with(shifted(lhs_jacobian(s, w, mu), cplx(0.0, omega)));
-  inverse_power_options ipo;
-  ipo.tolerance = 1e-8;  // a start for Newton, which converges the pair exactly
-  const auto t0 = std::chrono::steady_clock::now();
-  const eigen_pair ep = inverse_power(s.jacobian(w, mu), cplx(0.0, omega), ipo, nullptr, solver);
-  internal::flutter_say(log,
-                        "    inverse power (BILU(%d)-GMRES): lambda = %+.6f %+.6fi, %d iterations, %ld GMRES iterations, "
-                        "%.2f s\n",
-                        fill, ep.lambda.real(), ep.lambda.imag(), ep.iterations, ep.linear_iterations,
-                        internal::flutter_seconds_since(t0));
-  return internal::hopf_point_from(w, mu, ep);
-}
-
 namespace internal {
 
 /// The state of one trace_flutter_boundary call (its lambdas made members).
@@ -364,10 +334,10 @@ class flutter_boundary_tracer {
       ko.full_system = true;
       ko.start_iterations = 0;
     }
-    const hopf_options ho = hopf_opts(label, !o_.moving_equilibrium);
+    hopf_options ho = hopf_opts(label, !o_.moving_equilibrium);
     const auto t0 = clk::now();
     try {
-      hopf_result h = solve_hopf_krylov<B>(s, g, ho, ko);
+      hopf_result h = o_.moving_equilibrium ? full_hopf(s, g, ho, ko, label) : solve_hopf_krylov<B>(s, g, ho, ko);
       if (o_.parameter_even) h.point.mu = std::abs(h.point.mu);
       if (o_.verbose)
         flutter_say(log_, "    %s: setup (assembly + BILU) %.3f s, GMRES %.3f s, residuals %.3f s\n", label.c_str(),
@@ -388,6 +358,32 @@ class flutter_boundary_tracer {
       record(mach, kind, std::string("failed: ") + e.what(), flutter_seconds_since(t0));
       return std::nullopt;
     }
+  }
+
+  /// The full Hopf system from the continued guess; where that fails, once more from a refined
+  /// start: the fixed-equilibrium Hopf point with the flow frozen at the guess (the start
+  /// refinement of the eigenvector, to 1e-4), and the equilibrium at its mu. A continued
+  /// eigenvector is far off where shocks move (||F|| 25-36 and a first step through negative
+  /// densities, NACA 0012 coarse at alpha_0 = 1 deg, M > 0.66).
+  hopf_result full_hopf(const S& s, hopf_point g, const hopf_options& ho, const hopf_krylov_options& ko,
+                        const std::string& label) {
+    try {
+      return solve_hopf_krylov<B>(s, g, ho, ko);
+    } catch (const error& e) {
+      flutter_say(log_, "    %s: %s\n    -> again from the fixed-equilibrium Hopf point at the frozen flow\n",
+                  label.c_str(), e.what());
+    }
+    hopf_options fo = hopf_opts(label + " (fixed-equilibrium start)", true);
+    fo.newton.abs_tolerance = std::max(o_.tolerance, 1e-4);
+    fo.equilibrium_tolerance = 1e300;  // w is the equilibrium of the guess's mu, not of the point's
+    hopf_krylov_options kf = o_.krylov;
+    kf.fill_level = o_.fill_level;
+    const hopf_result h0 = solve_hopf_krylov<B>(s, g, fo, kf);
+    g.p = h0.point.p;
+    g.mu = o_.parameter_even ? std::abs(h0.point.mu) : h0.point.mu;
+    g.omega = h0.point.omega;
+    g.w = f_.equilibrium(s, g.mu);
+    return solve_hopf_krylov<B>(s, g, ho, ko);
   }
 
   void write(flutter_boundary_point p, double cos, bool jump = false) {
@@ -755,7 +751,15 @@ flutter_boundary flutter_boundary_tracer<F>::run() {
         guess = std::move(*cg);
         kind = "first";
       } else {
-        guess = hopf_start_krylov<B>(s, st.w, o_.start_mu, o_.start_omega, o_.fill_level, o_.start_restart, log_);
+        hopf_start_krylov_options so;
+        so.fill_level = o_.fill_level;
+        so.krylov.restart = o_.start_restart;
+        eigen_pair ep;
+        const auto ts = clk::now();
+        guess = hopf_start_krylov<B>(s, st.w, o_.start_mu, o_.start_omega, so, &ep);
+        flutter_say(log_, "    inverse power (BILU(%d)-GMRES): lambda = %+.6f %+.6fi, %d iterations, %ld GMRES, %.2f s\n",
+                    o_.fill_level, ep.lambda.real(), ep.lambda.imag(), ep.iterations, ep.linear_iterations,
+                    flutter_seconds_since(ts));
         guess.mu = o_.start_mu;
         kind = "first";
       }
