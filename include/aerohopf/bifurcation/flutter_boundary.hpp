@@ -714,7 +714,21 @@ flutter_boundary flutter_boundary_tracer<F>::run() {
       if (!pts_.empty()) step = std::min(step, mach - pts_.back().mach);
       const double m = pts_.empty() || step >= mach - pts_.back().mach ? mach : pts_.back().mach + step;
       const S s = f_.system(level_, m);
-      const solved_flow& st = flow_at(s, m, pts_.empty() ? o_.start_mu : pts_.back().mu);
+      const solved_flow* stp = nullptr;
+      try {
+        stp = &flow_at(s, m, pts_.empty() ? o_.start_mu : pts_.back().mu);
+      } catch (const error& e) {  // no equilibrium at m: a failed attempt, as a failed Hopf solve
+        if (pts_.empty()) throw;
+        flutter_say(log_, "    %s: no equilibrium: %s\n", label_at(m).c_str(), e.what());
+        record(m, "equilibrium", std::string("failed: ") + e.what(), 0.0);
+        if (step < full_step / o_.min_step_divisor + 1e-12) {
+          b_.stop_reason = "no equilibrium at M = " + flutter_fixed(m, 5) + ": " + e.what();
+          return std::move(b_);
+        }
+        step *= 0.5;
+        continue;
+      }
+      const solved_flow& st = *stp;
       hopf_point guess;
       const std::string label = label_at(m);
       const auto t0 = clk::now();
