@@ -647,3 +647,29 @@ TEST(hopf_bordered_full, incidence_fixed_equilibrium_is_refused) {
   EXPECT_FALSE(r.report.converged);
   EXPECT_NE(r.report.reason.find("equilibrium does not hold at mu*"), std::string::npos) << r.report.reason;
 }
+
+// hopf_start_krylov (complex BILU-GMRES inverse power on the model's block Jacobians) against
+// hopf_start (sparse LU of A - i omega I): the same eigenvalue and eigenvector, with BILU of the
+// modified-order L and of the exact A.
+TEST(hopf_bordered_full, krylov_start_matches_the_sparse_lu_start) {
+  const auto& f = incidence();
+  inverse_power_options ipo;
+  ipo.tolerance = 1e-10;
+  const hopf_point lu = hopf_start(f.s, f.w_guess, 1.75, 0.6, ipo);
+  for (const bool exact : {false, true}) {
+    hopf_start_krylov_options so;
+    so.precondition_exact = exact;
+    so.inverse_power.tolerance = 1e-10;
+    so.krylov.relative_tolerance = 1e-12;  // below the eigen-residual target (inverse_power.hpp)
+    eigen_pair info;
+    const hopf_point k = hopf_start_krylov<4>(f.s, f.w_guess, 1.75, 0.6, so, &info);
+    std::cout << (exact ? "BILU(A)" : "BILU(L)") << " start: lambda " << info.lambda << ", " << info.iterations
+              << " inverse iterations, " << info.linear_iterations << " GMRES\n";
+    EXPECT_NEAR(k.omega, lu.omega, 1e-9);
+    EXPECT_NEAR(std::abs(k.p.dot(lu.p)) / (k.p.norm() * lu.p.norm()), 1.0, 1e-9);
+    EXPECT_EQ(k.mu, 1.75);
+    EXPECT_EQ(k.w, f.w_guess);
+    EXPECT_LE(info.residual, 1e-10 * std::max(1.0, std::abs(info.lambda)));
+    EXPECT_GT(info.linear_iterations, info.iterations);
+  }
+}
