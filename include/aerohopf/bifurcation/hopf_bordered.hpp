@@ -84,6 +84,7 @@
 #include "../linalg/direct.hpp"
 #include "../linalg/krylov.hpp"
 #include "../linalg/operator.hpp"
+#include "../nonlinear/block_system.hpp"
 #include "../nonlinear/newton.hpp"
 #include "../nonlinear/system.hpp"
 #include "../scalar/jet.hpp"
@@ -317,29 +318,17 @@ hopf_result solve_hopf_bordered(const S& sys, const hopf_point& guess, const hop
 /// (triplets, sort, re-blocking), about half of the assembly time on the NACA 0012 grids.
 /// block_jacobians(w, mu) gives both (exact, approximate) at once, sharing what they have in common.
 template <class S, int B>
-concept has_block_jacobians = requires(const S& s, const vec<double>& w, double mu) {
-  { s.block_jacobian(w, mu) } -> std::same_as<block_sparse_matrix<double, B>>;
-  { s.approximate_block_jacobian(w, mu) } -> std::same_as<block_sparse_matrix<double, B>>;
-  { s.block_jacobians(w, mu) } -> std::same_as<std::pair<block_sparse_matrix<double, B>, block_sparse_matrix<double, B>>>;
-};
+concept has_block_jacobians = block_system_of<S, B>;
 
 namespace internal {
-/// A model's own block Jacobian must have the padded size of the system (logical size n).
-template <int B, dynamical_system S>
-const block_sparse_matrix<double, B>& checked_block_size(const S& sys, const block_sparse_matrix<double, B>& m,
-                                                         const std::string& who) {
-  require(m.rows() == padded_block_count(sys.size(), B) * B && m.cols() == m.rows() && m.logical_rows() == sys.size(),
-          who, ": block Jacobian is ", m.logical_rows(), " (padded ", m.rows(), ") square, system ", sys.size());
-  return m;
-}
 /// The exact Jacobian of sys at (w, mu) in blocks of B (padded to a multiple of B, logical size
-/// n): the system's own block assembly if it has one (has_block_jacobians), else from_sparse.
+/// n): the block_system's own assembly (checked_exact_jacobian; its block size must be B), else
+/// from_sparse.
 template <int B, dynamical_system S>
 block_sparse_matrix<double, B> exact_blocks(const S& sys, const vec<double>& w, double mu, const std::string& who) {
-  if constexpr (has_block_jacobians<S, B>) {
-    block_sparse_matrix<double, B> a = sys.block_jacobian(w, mu);
-    checked_block_size(sys, a, who);
-    return a;
+  if constexpr (block_system<S>) {
+    require_block_size<B, S>();
+    return checked_exact_jacobian(sys, w, mu, who);
   } else {
     return block_sparse_matrix<double, B>::from_sparse(sys.jacobian(w, mu), B);
   }
@@ -349,11 +338,10 @@ block_sparse_matrix<double, B> exact_blocks(const S& sys, const vec<double>& w, 
 template <int B, dynamical_system S>
 std::pair<block_sparse_matrix<double, B>, block_sparse_matrix<double, B>> exact_and_lhs_blocks(
     const S& sys, const vec<double>& w, double mu, const std::string& who) {
-  if constexpr (has_block_jacobians<S, B>) {
-    auto pair = sys.block_jacobians(w, mu);
-    checked_block_size(sys, pair.first, who);
-    checked_block_size(sys, pair.second, who);
-    return pair;
+  if constexpr (block_system<S>) {
+    require_block_size<B, S>();
+    auto p = checked_jacobians(sys, w, mu, who);
+    return {std::move(p.exact), std::move(p.preconditioning)};
   } else {
     return {block_sparse_matrix<double, B>::from_sparse(sys.jacobian(w, mu), B),
             block_sparse_matrix<double, B>::from_sparse(lhs_jacobian(sys, w, mu), B)};
