@@ -1,7 +1,7 @@
 // The flutter boundary Ubar(M) of the pitch-plunge NACA 0012 (spec 05) traced from ONE start by
-// pseudo-arclength continuation of the symmetric Hopf curve with Krylov linear algebra, the
+// pseudo-arclength continuation of the fixed-equilibrium Hopf curve with Krylov linear algebra, the
 // steady flow an unknown of the corrector (or a nested steady solve per Mach number)
-// (trace_symmetric_hopf_curve, bifurcation/hopf_curve_symmetric.hpp): through the steep transonic branches of the heavy case (M ~ 0.83
+// (trace_fixed_equilibrium_hopf_curve, bifurcation/hopf_curve_fixed_equilibrium.hpp): through the steep transonic branches of the heavy case (M ~ 0.83
 // and 0.89) where natural continuation in M stops, at grid sizes where the full-system tracer
 // (hopf_curve.hpp, sparse LU) is too expensive.
 //
@@ -19,7 +19,7 @@
 // and a summary: points, turning points of the curve in M (and extrema of Ubar), cost per
 // point against one steady solve from the free stream.
 #include <aerohopf/bifurcation/hopf.hpp>
-#include <aerohopf/bifurcation/hopf_curve_symmetric.hpp>
+#include <aerohopf/bifurcation/hopf_curve_fixed_equilibrium.hpp>
 #include <aerohopf/io/csv.hpp>
 
 #include <algorithm>
@@ -46,7 +46,7 @@ struct options {
   int max_points = 400;
   double mu_scale = 0.5, nu_scale = 0.01, omega_scale = 0.05;  // metric of the arclength
   double max_step = 1.0;
-  bool joint = true;  // symmetric_hopf_curve_options::joint_equilibrium (--corrector)
+  bool joint = true;  // fixed_equilibrium_hopf_curve_options::joint_equilibrium (--corrector)
 };
 
 /// Vertex of the parabola through three points (x_k, y_k): a turning point of y(x)... located
@@ -107,16 +107,16 @@ int main(int argc, char** argv) {
                                                 o.max_step);
     hopf_curve_options& ho = to.curve;
     ho.max_points = o.max_points;
-    symmetric_hopf_curve_options& so = to.symmetric;
+    fixed_equilibrium_hopf_curve_options& so = to.fixed_equilibrium;
     so.joint_equilibrium = o.joint;
     csv_writer csv(o.out / ("hopf_curve_sym_" + c.name + "_" + g.name + ".csv"),
                    "mach,ubar,omega,newton_iterations,linear_iterations,step,seconds,landed");
-    so.observer = [&](const hopf_curve_point& p, const symmetric_hopf_curve_stats& s) {
+    so.observer = [&](const hopf_curve_point& p, const fixed_equilibrium_hopf_curve_stats& s) {
       // Ubar enters only through 1/Ubar^2 (spec 05): -Ubar is the same point; report |Ubar|
       csv.row({p.nu, std::abs(p.mu), p.omega, static_cast<long long>(p.newton_iterations),
                static_cast<long long>(s.linear_iterations), p.step, p.seconds, static_cast<long long>(p.landed)});
     };
-    const auto r = trace_symmetric_hopf_curve<4>(family, m0, guess, ho, +1, so);
+    const auto r = trace_fixed_equilibrium_hopf_curve<4>(family, m0, guess, ho, +1, so);
 
     // ---- summary ----
     const auto& pts = r.points;

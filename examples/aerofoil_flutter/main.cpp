@@ -72,7 +72,7 @@ flutter_boundary_options driver_options(const options& o, const structural_case&
   fo.label = c.name + " " + g.name;
   const tracer_options t = aerofoil_tracer_options(g, c, machs.front(), machs.back(), o.fill);
   fo.curve = t.curve;
-  fo.symmetric = t.symmetric;
+  fo.fixed_equilibrium = t.fixed_equilibrium;
   // the crossing check factorises i omega I - A_ff at every sampled frequency: ~1 s per LU on
   // the medium grid, so there only with --crossing-medium
   fo.check_crossings = o.jump_check && (g.stride >= 4 || (g.stride == 2 && o.crossing_medium));

@@ -94,7 +94,7 @@ inline hopf_start_krylov_options start_options(const options& o) {
 /// Hopf options of the single points (very coarse check, V-g fallback, reduced model): ||F|| <= 1e-10.
 inline hopf_options point_options(const options& o, const std::string& label) {
   hopf_options ho;
-  ho.symmetric = true;
+  ho.fixed_equilibrium = true;
   ho.label = label;
   ho.newton.abs_tolerance = 1e-10;
   ho.newton.max_iterations = 20;
@@ -278,7 +278,7 @@ inline int jump_check_part(const options& o, const boundaries& all) {
     for (const auto& [k, what] : flutter_check_points(family_of(c), b)) {
       const auto& p = b.points[k];
       const auto s = make_system(g, p.mach, c.mu_s);
-      const vec<double>& w0 = p.point.w;  // the steady flow at this Mach number (symmetric Hopf point)
+      const vec<double>& w0 = p.point.w;  // the steady flow at this Mach number (fixed-equilibrium Hopf point)
       bool ok = true;
       double worst_below = -1e300, lowest_unstable = NAN;
       for (double f : factors) {

@@ -2,9 +2,9 @@
 // Shared set-up of the aerofoil flutter example programs (main.cpp, branch.cpp): the grid
 // levels (every stride-th point of the fine NACA 0012 C-grid), the two structural cases of
 // spec 05, the coupled system at a Mach number, and the timed steady solve from the free
-// stream (the unit of cost the examples report), and the options of the symmetric Hopf-curve
+// stream (the unit of cost the examples report), and the options of the fixed-equilibrium Hopf-curve
 // tracer for this problem.
-#include <aerohopf/bifurcation/hopf_curve_symmetric.hpp>
+#include <aerohopf/bifurcation/hopf_curve_fixed_equilibrium.hpp>
 #include <aerohopf/error.hpp>
 #include <aerohopf/flow/naca_cgrid.hpp>
 #include <aerohopf/flow/steady_solver.hpp>
@@ -97,7 +97,7 @@ inline steady_result steady(const aerofoil_system& s) {
   return r;
 }
 
-/// Options of trace_symmetric_hopf_curve (bifurcation/hopf_curve_symmetric.hpp) for the aerofoil,
+/// Options of trace_fixed_equilibrium_hopf_curve (bifurcation/hopf_curve_fixed_equilibrium.hpp) for the aerofoil,
 /// shared by aerofoil_branch and the hand-over of natural continuation in aerofoil_flutter.
 /// Metric: Ubar / mu_scale, M / nu_scale, omega / omega_scale (default 0.5, 0.01, 0.05: a step
 /// of 1 is at most 0.01 in M); steps 0.5 .. max_step, down to 1e-3; Ubar in [0.2, 20]; M in
@@ -105,7 +105,7 @@ inline steady_result steady(const aerofoil_system& s) {
 /// quadratic steps when it converges: fail fast at kinks); BILU(fill); nested steady Newton to
 /// ||f|| <= 1e-10, its third start the pseudo-transient solve from the free stream.
 /// The value of --tracer-corrector / --corrector: true for "joint"
-/// (symmetric_hopf_curve_options::joint_equilibrium), false for "nested".
+/// (fixed_equilibrium_hopf_curve_options::joint_equilibrium), false for "nested".
 inline bool joint_corrector(const std::string& value, const std::string& option) {
   aerohopf::require(value == "joint" || value == "nested", option, " must be joint or nested (got ", value, ")");
   return value == "joint";
@@ -113,7 +113,7 @@ inline bool joint_corrector(const std::string& value, const std::string& option)
 
 struct tracer_options {
   aerohopf::hopf_curve_options curve;
-  aerohopf::symmetric_hopf_curve_options symmetric;
+  aerohopf::fixed_equilibrium_hopf_curve_options fixed_equilibrium;
 };
 inline tracer_options aerofoil_tracer_options(const grid_level& g, const structural_case& c, double m0, double m_max,
                                               int fill, double mu_scale = 0.5, double nu_scale = 0.01,
@@ -143,16 +143,16 @@ inline tracer_options aerofoil_tracer_options(const grid_level& g, const structu
   ho.label = c.name + " " + g.name;
   ho.verbose = true;
   ho.start.newton.max_iterations = 20;
-  t.symmetric.fill_level = fill;
+  t.fixed_equilibrium.fill_level = fill;
   // nested steady Newton: ||f||_2 <= 1e-10 (the default 1e-11 is at the rounding floor of the
   // medium grid: measured, Newton stalls at 1.6e-11 there); Hopf points are converged to 1e-7
-  t.symmetric.steady.abs_tolerance = 1e-10;
+  t.fixed_equilibrium.steady.abs_tolerance = 1e-10;
   // dw0/dnu only sets the Jacobian column G_nu and the warm start: GMRES to 1e-4 instead of 1e-8
   // cut the heavy medium stretch's steady + dw0/dnu GMRES iterations from 9331 to 7351 (18.5 ->
   // 16.3 s) with the same 82 steady solves and 175 steady Newton iterations, points within the
   // Newton tolerance (Ubar* within 1.2e-8), measured one run apart
-  t.symmetric.derivative_tolerance = 1e-4;
-  t.symmetric.equilibrium_start = [g, mu_s = c.mu_s](double mach) { return make_system(g, mach, mu_s).steady_equilibrium(); };
+  t.fixed_equilibrium.derivative_tolerance = 1e-4;
+  t.fixed_equilibrium.equilibrium_start = [g, mu_s = c.mu_s](double mach) { return make_system(g, mach, mu_s).steady_equilibrium(); };
   return t;
 }
 

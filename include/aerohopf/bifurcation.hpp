@@ -6,7 +6,7 @@
 #include "bifurcation/hopf.hpp"
 #include "bifurcation/hopf_bordered.hpp"
 #include "bifurcation/hopf_curve.hpp"
-#include "bifurcation/hopf_curve_symmetric.hpp"
+#include "bifurcation/hopf_curve_fixed_equilibrium.hpp"
 #include "bifurcation/hopf_point.hpp"
 #include "bifurcation/inverse_power.hpp"
 #include "bifurcation/root_locus.hpp"

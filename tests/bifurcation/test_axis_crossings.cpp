@@ -150,7 +150,7 @@ TEST(axis_crossings, aerofoil_lowest_crossing_is_the_hopf_point) {
   const double ubar = 1 / std::sqrt(lowest.q);
 
   hopf_options ho;
-  ho.symmetric = true;
+  ho.fixed_equilibrium = true;
   const hopf_result h = solve_hopf(s, hopf_start(s, w, 1.75, 0.6), ho);
   std::cout << "aerofoil: " << r.crossings.size() << " crossings, lowest Ubar = " << ubar << " omega = " << lowest.omega
             << " (Hopf solver: " << h.point.mu << ", " << h.point.omega << "), rank " << r.rank << ", "

@@ -85,8 +85,8 @@ flutter_boundary_options options_for(double ubar_guess, double omega_guess, cons
   ho.newton.max_iterations = 8;
   ho.newton.max_contraction = 1.0;
   ho.start.newton.max_iterations = 20;
-  o.symmetric.steady.abs_tolerance = 1e-10;
-  o.symmetric.derivative_tolerance = 1e-4;
+  o.fixed_equilibrium.steady.abs_tolerance = 1e-10;
+  o.fixed_equilibrium.derivative_tolerance = 1e-4;
   return o;
 }
 

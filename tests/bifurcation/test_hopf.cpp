@@ -123,13 +123,13 @@ TEST(hopf, SymmetricReducedSystemOnNormalForm) {
     hopf_point guess{vec<double>::Zero(nf.size()), 0.3, 1.2, {}};
     guess.p = inverse_power(nf.jacobian(guess.w, guess.mu), {0.0, 1.2}).vector;
     hopf_options ho;
-    ho.symmetric = true;
+    ho.fixed_equilibrium = true;
     const hopf_result h = solve_hopf(nf, guess, ho);
     ASSERT_TRUE(h.report.converged);
     EXPECT_NEAR(h.point.mu, 0.0, 1e-12);
     EXPECT_NEAR(h.point.omega, 1.0, 1e-12);
     // the full 3n+2 system gives the same point
-    ho.symmetric = false;
+    ho.fixed_equilibrium = false;
     const hopf_result f = solve_hopf(nf, guess, ho);
     EXPECT_NEAR(f.point.mu, 0.0, 1e-12);
     EXPECT_NEAR(f.point.omega, 1.0, 1e-12);
@@ -180,7 +180,7 @@ TEST(hopf_hostile, FixedEquilibriumRefusedWhenTheEquilibriumMovesWithMu) {
   const hopf_point g = hopf_start(s, s.equilibrium(0.9), 0.9, 1.9);  // w: the equilibrium at the guess's mu
   const hopf_point copy = g;
   hopf_options o;
-  o.symmetric = true;
+  o.fixed_equilibrium = true;
   try {
     solve_hopf(s, g, o);
     ADD_FAILURE() << "the moving equilibrium was accepted";
@@ -196,7 +196,7 @@ TEST(hopf_hostile, FixedEquilibriumRefusedWhenTheEquilibriumMovesWithMu) {
   EXPECT_FALSE(r.report.converged);
   EXPECT_NE(r.report.reason.find("equilibrium does not hold"), std::string::npos) << r.report.reason;
   // the full formulation: the exact point
-  o.symmetric = false;
+  o.fixed_equilibrium = false;
   o.newton.throw_on_failure = true;
   const hopf_result f = solve_hopf(s, g, o);
   ASSERT_TRUE(f.report.converged);
@@ -211,7 +211,7 @@ TEST(hopf_hostile, FixedEquilibriumRefusedForAStaleEquilibrium) {
   hopf_point g = hopf_start(s, s.equilibrium(1.0), 0.9, 1.9);
   g.w = s.equilibrium(0.3);  // converged at mu = 0.3, used at mu ~ 1
   hopf_options o;
-  o.symmetric = true;
+  o.fixed_equilibrium = true;
   EXPECT_THROW(solve_hopf(s, g, o), convergence_error);
   // ... while the true equilibrium at mu* (w* = c) passes
   g.w = s.equilibrium(1.0);
@@ -227,7 +227,7 @@ TEST(hopf_hostile, FixedEquilibriumRefusedAtARealEigenvalueWithAMovingEquilibriu
   const moving_equilibrium_system<> s(moving_c);
   const hopf_point g = real_eigenvalue_guess(s, 0.2);
   hopf_options o;
-  o.symmetric = true;
+  o.fixed_equilibrium = true;
   o.newton.abs_tolerance = 1e-8;
   EXPECT_THROW(solve_hopf(s, g, o), convergence_error);
   o.newton.throw_on_failure = false;
@@ -242,7 +242,7 @@ TEST(hopf_hostile, UnresolvedFrequencyRefused) {
   const moving_equilibrium_system<> s;
   const hopf_point g = real_eigenvalue_guess(s, 0.2);
   hopf_options o;
-  o.symmetric = true;
+  o.fixed_equilibrium = true;
   o.newton.abs_tolerance = 1e-8;
   try {
     solve_hopf(s, g, o);
@@ -345,7 +345,7 @@ TEST(hopf_hostile, NaNResidualDuringNewtonIsReportedWithTheLastGoodIterate) {
   ASSERT_GE(ref.report.iterations, 3);
   for (bool symmetric : {false, true}) {
     hopf_options so = o;
-    so.symmetric = symmetric;
+    so.fixed_equilibrium = symmetric;
     const moving_equilibrium_system<> base = symmetric ? moving_equilibrium_system<>() : clean;
     const hopf_point gs = symmetric ? far_guess(base, base.equilibrium(0.0)) : g;
     const faulty_system<moving_equilibrium_system<>> counted(base, 1L << 40);  // never faults

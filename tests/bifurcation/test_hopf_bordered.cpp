@@ -1,4 +1,4 @@
-// The bordered solvers of the symmetric Hopf system (hopf_bordered.hpp) on the coupled Euler /
+// The bordered solvers of the fixed-equilibrium Hopf system (hopf_bordered.hpp) on the coupled Euler /
 // pitch-plunge NACA 0012 (very coarse grid, light case, M = 0.5), against the independent
 // reference of solve_hopf (real (2n+2) sparse LU of the augmented matrix): the same flutter
 // point to 1e-9 from the same inverse-power start, the eigen-equation A p = i omega p satisfied,
@@ -42,7 +42,7 @@ struct fixture {
   hopf_point start = hopf_start(s, w, 1.75, 0.6);
   hopf_options opt = [] {
     hopf_options o;
-    o.symmetric = true;
+    o.fixed_equilibrium = true;
     return o;
   }();
 };
@@ -182,7 +182,7 @@ TEST(hopf_bordered, start_refinement_recovers_a_poor_eigenvector_guess) {
 TEST(hopf_bordered, refuses_bad_input) {
   const auto& f = fix();
   hopf_options not_sym = f.opt;
-  not_sym.symmetric = false;
+  not_sym.fixed_equilibrium = false;
   EXPECT_THROW(solve_hopf_krylov<4>(f.s, f.start, not_sym), input_error);
   hopf_point bad = f.start;
   bad.p.resize(3);
@@ -209,7 +209,7 @@ const Eigen::Vector4d moving_c(1.0, 0.5, -0.3, 0.2);
 
 hopf_options fixed_options(double tol = 1e-10) {
   hopf_options o;
-  o.symmetric = true;
+  o.fixed_equilibrium = true;
   o.newton.abs_tolerance = tol;
   return o;
 }
@@ -385,7 +385,7 @@ TEST(hopf_bordered_hostile, krylov_options_are_checked) {
 namespace {
 hopf_options full_options(double tol = 1e-10) {
   hopf_options o;
-  o.symmetric = false;
+  o.fixed_equilibrium = false;
   o.newton.abs_tolerance = tol;
   return o;
 }
@@ -635,13 +635,13 @@ TEST(hopf_bordered_full, incidence_dense_spectrum_crosses_at_the_hopf_point) {
 }
 
 // The fixed-equilibrium formulation is refused here: the Krylov solver without full_system
-// (input_error), and with hopf_options::symmetric by its post-check, as the equilibrium of
+// (input_error), and with hopf_options::fixed_equilibrium by its post-check, as the equilibrium of
 // Ubar = 1.75 does not hold at the Ubar it converges to.
 TEST(hopf_bordered_full, incidence_fixed_equilibrium_is_refused) {
   const auto& f = incidence();
   EXPECT_THROW(solve_hopf_krylov<4>(f.s, f.start, full_options()), input_error);
   hopf_options o = full_options();
-  o.symmetric = true;
+  o.fixed_equilibrium = true;
   o.newton.throw_on_failure = false;
   const hopf_result r = solve_hopf_krylov<4>(f.s, f.start, o);
   EXPECT_FALSE(r.report.converged);

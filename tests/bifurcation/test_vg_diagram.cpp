@@ -283,7 +283,7 @@ TEST(vg_diagram, aerofoil_zero_damping_is_the_hopf_point) {
   const auto s = test_support::heavy_very_coarse_aerofoil(0.5);
   const vec<double> w = s.steady_equilibrium();
   hopf_options ho;
-  ho.symmetric = true;
+  ho.fixed_equilibrium = true;
   const hopf_result h = solve_hopf(s, hopf_start(s, w, 4.6, 0.22), ho);
   ASSERT_TRUE(h.report.converged);
   const double ubar_star = std::abs(h.point.mu), omega_star = h.point.omega;

@@ -10,7 +10,7 @@
 
 #include <aerohopf/bifurcation/hopf.hpp>
 #include <aerohopf/bifurcation/hopf_bordered.hpp>
-#include <aerohopf/bifurcation/hopf_curve_symmetric.hpp>
+#include <aerohopf/bifurcation/hopf_curve_fixed_equilibrium.hpp>
 #include <aerohopf/flow/naca_cgrid.hpp>
 #include <aerohopf/flow/steady_solver.hpp>
 #include <aerohopf/models/aerofoil.hpp>
@@ -86,7 +86,7 @@ TEST(aerofoil_hopf, block_jacobians_give_the_same_krylov_hopf_iterates_as_the_sp
 
   const hopf_point start = hopf_start(s, w, 1.75, 0.6);
   hopf_options opt;
-  opt.symmetric = true;
+  opt.fixed_equilibrium = true;
   opt.newton.abs_tolerance = 1e-9;
   const hopf_result hb = solve_hopf_krylov<4>(s, start, opt);
   const hopf_result hs = solve_hopf_krylov<4>(sparse_owner{s}, start, opt);
@@ -109,7 +109,7 @@ TEST(aerofoil_hopf, light_case_flutter_point_matches_dense_spectrum) {
 
   const hopf_point start = hopf_start(s, w, 1.75, 0.6);
   hopf_options opt;
-  opt.symmetric = true;
+  opt.fixed_equilibrium = true;
   const hopf_result h = solve_hopf(s, start, opt);
   const double ubar = h.point.mu, omega = h.point.omega;
   std::cout << "flutter point: Ubar* = " << ubar << ", omega* = " << omega << " (Newton iterations "
@@ -142,7 +142,7 @@ TEST(aerofoil_hopf, hopf_curve_tracer_gives_the_same_points_with_block_jacobians
   const aerofoil_system s0 = light_very_coarse(m0);
   const vec<double> w = s0.steady_equilibrium();
   hopf_options ho;
-  ho.symmetric = true;
+  ho.fixed_equilibrium = true;
   hopf_point start = solve_hopf(s0, hopf_start(s0, w, 1.75, 0.6), ho).point;
   hopf_curve_options co;
   co.mu_scale = 0.5;
@@ -153,11 +153,11 @@ TEST(aerofoil_hopf, hopf_curve_tracer_gives_the_same_points_with_block_jacobians
   co.max_points = 3;
   co.nu_targets = {0.51};
   co.throw_on_failure = true;
-  symmetric_hopf_curve_options so;
+  fixed_equilibrium_hopf_curve_options so;
   so.steady.abs_tolerance = 1e-10;
-  const auto rb = trace_symmetric_hopf_curve<4>([](double m) { return light_very_coarse(m); }, m0, start, co, +1, so);
+  const auto rb = trace_fixed_equilibrium_hopf_curve<4>([](double m) { return light_very_coarse(m); }, m0, start, co, +1, so);
   const auto rs =
-      trace_symmetric_hopf_curve<4>([](double m) { return sparse_owner{light_very_coarse(m)}; }, m0, start, co, +1, so);
+      trace_fixed_equilibrium_hopf_curve<4>([](double m) { return sparse_owner{light_very_coarse(m)}; }, m0, start, co, +1, so);
   ASSERT_EQ(rb.points.size(), 3u);
   ASSERT_EQ(rs.points.size(), rb.points.size());
   EXPECT_EQ(rb.linear_iterations, rs.linear_iterations);

@@ -61,7 +61,7 @@ TEST(aerofoil_hopf_long, heavy_case_flutter_bracket_and_hopf_point) {
   ASSERT_GT(lo, 0.0) << "no complex crossing found in the scan";
   const hopf_point start = hopf_start(s, w, 0.5 * (lo + hi), omega_guess);
   hopf_options opt;
-  opt.symmetric = true;
+  opt.fixed_equilibrium = true;
   const hopf_result h = solve_hopf(s, start, opt);
   std::cout << "heavy case flutter point: Ubar* = " << h.point.mu << ", omega* = " << h.point.omega << " (bracket ["
             << lo << ", " << hi << "])\n";

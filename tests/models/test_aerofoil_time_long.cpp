@@ -42,7 +42,7 @@ TEST(aerofoil_time_long, growth_rates_straddling_the_flutter_point_match_dense_s
                           structure::pitch_plunge(p));
   const vec<double> w = s.steady_equilibrium();
   hopf_options hopt;
-  hopt.symmetric = true;
+  hopt.fixed_equilibrium = true;
   const hopf_result h = solve_hopf(s, hopf_start(s, w, 1.75, 0.6), hopt);
   const double ubar = h.point.mu, omega = h.point.omega;
   bdf2_options opt;

@@ -1,7 +1,7 @@
 #pragma once
 // Newton-Krylov solve of the equilibrium f(w, mu) = 0 of a dynamical system from a NEARBY state:
 // the steady flow at a Mach number next to ones already solved (a continuation in M, the nested
-// steady solves of the symmetric Hopf-curve tracer). The pseudo-transient solver of
+// steady solves of the fixed-equilibrium Hopf-curve tracer). The pseudo-transient solver of
 // flow/steady_solver.hpp is the robust start from the free stream; from a good guess it is the
 // wrong tool (measured on the medium aerofoil grid, M = 0.90 -> 0.9012: still 25-71
 // pseudo-time steps, as its CFL law and its relative stopping test are built for a start far away),
@@ -82,7 +82,7 @@ inline double inexact_forcing(double fn, double abs_tol, double eta_max) {
 }
 
 /// The Newton-Krylov equilibrium solve of solve_equilibrium_krylov with the caller's BILU object
-/// (after the call it holds the factorisation of lhs_jacobian at the start, which the symmetric
+/// (after the call it holds the factorisation of lhs_jacobian at the start, which the fixed-equilibrium
 /// Hopf-curve tracer reuses for dw0/dnu). linear_iterations is incremented, not reset.
 /// Failures are thrown unless throw_on_failure is false (then returned, newton_iterate's
 /// contract); the default true is the contract of the nested solves of the Hopf-curve tracer.

@@ -20,7 +20,7 @@
 // steep branches), and the coarser boundary's increments predict mu, omega and, where the
 // secant one is far off, the eigenvector. Where even the smallest step finds only the other
 // mode, the branch has ended and the boundary JUMPS to that mode; where nothing converges,
-// the fixed-equilibrium Hopf-curve tracer (trace_symmetric_hopf_curve) takes over up to the
+// the fixed-equilibrium Hopf-curve tracer (trace_fixed_equilibrium_hopf_curve) takes over up to the
 // next listed Mach number it lands on.
 //
 // Cost accounting: a listed Mach number's equilibrium from scratch is the unit; every other
@@ -54,7 +54,7 @@
 #include "equilibrium_krylov.hpp"
 #include "hopf.hpp"
 #include "hopf_bordered.hpp"
-#include "hopf_curve_symmetric.hpp"
+#include "hopf_curve_fixed_equilibrium.hpp"
 #include "inverse_power.hpp"
 
 namespace aerohopf {
@@ -129,10 +129,10 @@ struct flutter_boundary_options {
   /// crossing check (both assume A0 independent of mu) applies: they are skipped.
   bool moving_equilibrium = false;
   /// Hand-over to the fixed-equilibrium Hopf-curve tracer (its step metric and bounds are the
-  /// model's: set curve.mu_scale, nu_scale, omega_scale, mu_min, mu_max, symmetric.fill_level...).
+  /// model's: set curve.mu_scale, nu_scale, omega_scale, mu_min, mu_max, fixed_equilibrium.fill_level...).
   bool handover = true;
   hopf_curve_options curve;
-  symmetric_hopf_curve_options symmetric;
+  fixed_equilibrium_hopf_curve_options fixed_equilibrium;
   double fold_tolerance = 0.005;   ///< the traced curve turning back in M by more: stop
   double retrace_distance = 0.1;   ///< in the tracer's metric: a point this close to the old trail is a retrace
   int handover_max_points = 200;
@@ -308,7 +308,7 @@ class flutter_boundary_tracer {
 
   hopf_options hopf_opts(const std::string& label, bool fixed = true) const {
     hopf_options ho;
-    ho.symmetric = fixed;
+    ho.fixed_equilibrium = fixed;
     ho.label = label;
     ho.newton.abs_tolerance = o_.tolerance;
     ho.newton.max_iterations = o_.max_iterations;
@@ -558,7 +558,7 @@ hopf_point flutter_boundary_tracer<F>::predict(const S& s, double m, const solve
         hopf_point h = guess;
         h.w = st.w;
         vec<double> y;
-        const symmetric_hopf_problem<S> pr(s, h, hopf_opts(label + " predictor"), "predictor", y);
+        const fixed_equilibrium_hopf_problem<S> pr(s, h, hopf_opts(label + " predictor"), "predictor", y);
         const double f_secant = pr.residual(y).norm();
         use_increment = !(f_secant <= o_.krylov.start_residual_threshold);
         if (o_.verbose)
@@ -589,7 +589,7 @@ hopf_point flutter_boundary_tracer<F>::predict(const S& s, double m, const solve
 template <flutter_family F>
 std::vector<flutter_boundary_point> flutter_boundary_tracer<F>::arclength_bridge(const flutter_boundary_point& from) {
   hopf_curve_options ho = o_.curve;
-  symmetric_hopf_curve_options so = o_.symmetric;
+  fixed_equilibrium_hopf_curve_options so = o_.fixed_equilibrium;
   ho.nu_min = from.mach - 1e-9;
   ho.nu_max = machs_.back();
   ho.nu_targets.clear();
@@ -612,7 +612,7 @@ std::vector<flutter_boundary_point> flutter_boundary_tracer<F>::arclength_bridge
   }
   double m_hi = from.mach;
   std::vector<flutter_boundary_point> out;
-  so.observer = [&](const hopf_curve_point& p, const symmetric_hopf_curve_stats& st) {
+  so.observer = [&](const hopf_curve_point& p, const fixed_equilibrium_hopf_curve_stats& st) {
     if (p.nu <= m_hi + 1e-9) return;  // the start, or a point back in M
     m_hi = p.nu;
     hopf_point q = p.point();
@@ -663,7 +663,7 @@ std::vector<flutter_boundary_point> flutter_boundary_tracer<F>::arclength_bridge
               "    hand-over to pseudo-arclength continuation of the Hopf curve from M = %.5f (mu* = %.5f, omega* = "
               "%.5f) up to the next listed Mach number\n",
               from.mach, from.mu, from.omega);
-  symmetric_hopf_curve_result r;
+  fixed_equilibrium_hopf_curve_result r;
   const auto t_bridge = clk::now();
   // the stretch's time not in its points' own steps (the re-solved start, points back in M, the
   // step past the landed Mach number) goes to its last point
@@ -674,7 +674,7 @@ std::vector<flutter_boundary_point> flutter_boundary_tracer<F>::arclength_bridge
     out.back().hopf_seconds += std::max(0.0, flutter_seconds_since(t_bridge) - own);
   };
   try {
-    r = trace_symmetric_hopf_curve<B>(family, from.mach, from.point, ho, +1, so);
+    r = trace_fixed_equilibrium_hopf_curve<B>(family, from.mach, from.point, ho, +1, so);
   } catch (const error& e) {  // e.g. the start's nested steady solve: keep what was traced
     flutter_say(log_, "    arclength failed: %s\n", e.what());
     charge_rest();

@@ -10,7 +10,7 @@
 //           0          s^T       0         0           0
 //           0          0         s^T       0           0   ]
 //
-// The symmetric case (the equilibrium w0 does not depend on mu, e.g. a symmetric aerofoil at
+// The fixed-equilibrium case (w0 does not depend on mu, e.g. a symmetric aerofoil at
 // zero incidence) drops the first block row and column: unknowns [p_r, p_i, mu, omega].
 //
 // The right-hand side products A p are evaluated matrix-free with the EXACT residual (one
@@ -77,7 +77,7 @@ struct hopf_options {
     return o;
   }();
   bool approximate_lhs = false;  ///< use the system's approximate Jacobian in J_A
-  bool symmetric = false;        ///< w fixed (independent of mu): solve for [p_r, p_i, mu, omega]
+  bool fixed_equilibrium = false;        ///< w fixed (independent of mu): solve for [p_r, p_i, mu, omega]
   hopf_normalisation normalisation = hopf_normalisation::automatic;  ///< choice of s
   /// Acceptance of the equilibrium after convergence (see "Post-checks" in the file comment):
   /// ||f(w*, mu*)|| must not exceed max(equilibrium_tolerance, equilibrium_factor x the
@@ -210,7 +210,7 @@ std::string hopf_post_check(const S& sys, const hopf_point& h, const newton_repo
     return concat("the equilibrium does not hold at mu* = ", h.mu, " (omega = ", h.omega, "): ||f(w, mu*)|| = ", fn,
                   " > tolerance ", tol_f,
                   fixed_equilibrium
-                      ? " (fixed-equilibrium formulation, hopf_options::symmetric: w must be an equilibrium at every "
+                      ? " (fixed-equilibrium formulation, hopf_options::fixed_equilibrium: w must be an equilibrium at every "
                         "mu; an equilibrium that moves with mu, or w from another mu? use the full formulation or "
                         "re-converge w at mu*)"
                       : "");
@@ -344,7 +344,7 @@ hopf_result solve_hopf(const S& sys, const hopf_point& guess, const hopf_options
   vec<std::complex<double>> p = guess.p;
   const hopf_normalisation mode = resolve_normalisation<M>(opt.normalisation);
   const vec<double> s = hopf_normalise(p, mode);
-  const bool sym = opt.symmetric;
+  const bool sym = opt.fixed_equilibrium;
   const Eigen::Index off = sym ? 0 : n;  // offset of p_r in the unknown vector
   const Eigen::Index N = off + 2 * n + 2;
   vec<double> x(N);

@@ -1,5 +1,5 @@
 #pragma once
-// The reduced (symmetric) Hopf system solved by BORDERING on the complex matrix, so that the
+// The reduced (fixed-equilibrium) Hopf system solved by BORDERING on the complex matrix, so that the
 // only linear systems are n x n complex ones with the sparsity of A, which a BILU(k)-Krylov
 // solver handles (the original scheme of the flutter method) instead of a sparse LU of the
 // real (2n+2) system, whose fill grows too fast for CFD grids.
@@ -49,7 +49,7 @@
 //   Preconditioning with BILU(k) of the EXACT shifted matrix (precondition_exact) needs fewer
 //   GMRES iterations at k = 3 but costs more per Hopf point (2.0 x the steady solve at k = 1..3).
 //
-// Full formulation (hopf_krylov_options::full_system; hopf_options::symmetric = false): the
+// Full formulation (hopf_krylov_options::full_system; hopf_options::fixed_equilibrium = false): the
 // equilibrium moves with mu (an asymmetric section or a mean incidence: the static aeroelastic
 // deflection depends on Ubar), unknowns [w, p_r, p_i, mu, omega] (3n + 2) with the augmented
 // system of hopf.hpp. The flow update is eliminated inside the Newton step: with
@@ -108,18 +108,18 @@ inline void add_hopf_progress(newton_options& nopt, const hopf_options& opt, Eig
   };
 }
 
-/// Unknowns y = [p_r, p_i, mu, omega] of the symmetric Hopf system, with its exact residual
+/// Unknowns y = [p_r, p_i, mu, omega] of the fixed-equilibrium Hopf system, with its exact residual
 /// (matrix-free) and the unpacking of the converged point; shared by the bordered solvers.
 template <dynamical_system S>
-struct symmetric_hopf_problem {
+struct fixed_equilibrium_hopf_problem {
   const S& sys;
   vec<double> w, s;
   Eigen::Index n, N;
 
-  symmetric_hopf_problem(const S& system, const hopf_point& guess, const hopf_options& opt, const char* who,
+  fixed_equilibrium_hopf_problem(const S& system, const hopf_point& guess, const hopf_options& opt, const char* who,
                          vec<double>& y0)
       : sys(system), w(guess.w), n(system.size()), N(2 * system.size() + 2) {
-    require(opt.symmetric, who, ": only the symmetric (fixed equilibrium) system is implemented; set hopf_options::symmetric");
+    require(opt.fixed_equilibrium, who, ": only the fixed-equilibrium system is implemented; set hopf_options::fixed_equilibrium");
     check_hopf_guess(sys, guess, who);
     check_hopf_options(opt, who);
     vec<std::complex<double>> p0 = guess.p;
@@ -247,7 +247,7 @@ struct complex_preconditioner_split_form {
 
 }  // namespace internal
 
-/// Newton on the reduced Hopf system by bordering (see the file comment). opt.symmetric must be
+/// Newton on the reduced Hopf system by bordering (see the file comment). opt.fixed_equilibrium must be
 /// set (w = guess.w stays fixed); opt.approximate_lhs selects L; opt.normalisation as in
 /// solve_hopf (automatic: largest component for sparse Jacobians).
 template <dynamical_system S, class ComplexSolver>
@@ -256,7 +256,7 @@ hopf_result solve_hopf_bordered(const S& sys, const hopf_point& guess, const hop
   using C = std::complex<double>;
   using M = jacobian_t<S>;
   vec<double> x;
-  const internal::symmetric_hopf_problem<S> prob(sys, guess, opt, "solve_hopf_bordered", x);
+  const internal::fixed_equilibrium_hopf_problem<S> prob(sys, guess, opt, "solve_hopf_bordered", x);
   const Eigen::Index n = prob.n, N = prob.N;
   const vec<double>& w = prob.w;
   const vec<double>& s = prob.s;
@@ -398,7 +398,7 @@ struct hopf_krylov_options {
   /// needs 3-4 iterations without the refinement and it does not pay, and 37-280 at transonic ones.
   double start_residual_threshold = 0.0;
   /// The FULL Hopf system (3n + 2 unknowns [w, p_r, p_i, mu, omega], the equilibrium moving with
-  /// mu: hopf_options::symmetric must be false) instead of the fixed-equilibrium one, solved by
+  /// mu: hopf_options::fixed_equilibrium must be false) instead of the fixed-equilibrium one, solved by
   /// eliminating the flow update dw inside the same bordered Krylov solve ("Full formulation" in
   /// the file comment). Matrices and both BILU factorisations are then refreshed at every Newton
   /// iterate (reuse_matrices and reuse_window do not apply: A moves with w), and the start
@@ -515,9 +515,9 @@ struct full_hopf_problem {
   full_hopf_problem(const S& system, const hopf_point& guess, const hopf_options& opt, const char* who,
                     vec<double>& y0)
       : sys(system), n(system.size()), N(3 * system.size() + 2) {
-    require(!opt.symmetric, who,
+    require(!opt.fixed_equilibrium, who,
             ": hopf_krylov_options::full_system solves the full formulation (the equilibrium as unknown); "
-            "hopf_options::symmetric must be false");
+            "hopf_options::fixed_equilibrium must be false");
     check_hopf_guess(sys, guess, who);
     check_hopf_options(opt, who);
     vec<std::complex<double>> p0 = guess.p;
@@ -672,24 +672,24 @@ hopf_result solve_hopf_krylov_full(const S& sys, const hopf_point& guess, const 
 }
 }  // namespace internal
 
-/// Newton on the symmetric Hopf system with the exact bordered matrix, GMRES and the bordered
+/// Newton on the fixed-equilibrium Hopf system with the exact bordered matrix, GMRES and the bordered
 /// complex-BILU(k) preconditioner of the modified-order matrix (file comment). B is the block
 /// size of the system's unknowns (4 for 2D Euler + pitch-plunge); n must be a multiple of B or
-/// is padded. opt.symmetric must be set; opt.approximate_lhs is ignored (the preconditioner
+/// is padded. opt.fixed_equilibrium must be set; opt.approximate_lhs is ignored (the preconditioner
 /// always uses lhs_jacobian, the operator always the exact Jacobian).
 template <int B, dynamical_system S>
   requires is_sparse_matrix_v<jacobian_t<S>>
 hopf_result solve_hopf_krylov(const S& sys, const hopf_point& guess, const hopf_options& opt,
                               const hopf_krylov_options& kopt = {}) {
   if (kopt.full_system) return internal::solve_hopf_krylov_full<B>(sys, guess, opt, kopt);
-  require(opt.symmetric,
-          "solve_hopf_krylov: hopf_options::symmetric = false (the equilibrium moves with mu) needs the full "
-          "formulation: set hopf_krylov_options::full_system (or hopf_options::symmetric for a fixed equilibrium)");
+  require(opt.fixed_equilibrium,
+          "solve_hopf_krylov: hopf_options::fixed_equilibrium = false (the equilibrium moves with mu) needs the full "
+          "formulation: set hopf_krylov_options::full_system (or hopf_options::fixed_equilibrium for a fixed equilibrium)");
   using C = std::complex<double>;
   using M = jacobian_t<S>;
   vec<double> x;
-  // validates the guess (sizes, finiteness, symmetric option); rebuilt below if the start is refined
-  std::optional<internal::symmetric_hopf_problem<S>> prob_storage;
+  // validates the guess (sizes, finiteness, fixed_equilibrium option); rebuilt below if the start is refined
+  std::optional<internal::fixed_equilibrium_hopf_problem<S>> prob_storage;
   prob_storage.emplace(sys, guess, opt, "solve_hopf_krylov", x);
   internal::check_hopf_krylov_options(kopt, "solve_hopf_krylov");
   const Eigen::Index n = prob_storage->n, N = prob_storage->N;
@@ -760,7 +760,7 @@ hopf_result solve_hopf_krylov(const S& sys, const hopf_point& guess, const hopf_
                       v.head(n).dot(av.tail(n)) - v.tail(n).dot(av.head(n)));
       if (pap.imag() * om > 0) g.omega = pap.imag();
       vec<double> xg;
-      internal::symmetric_hopf_problem<S> refined(sys, g, opt, "solve_hopf_krylov", xg);
+      internal::fixed_equilibrium_hopf_problem<S> refined(sys, g, opt, "solve_hopf_krylov", xg);
       const auto t1 = clock::now();
       const double f_old = f_guess, f_new = refined.residual(xg).norm();
       residual_seconds += since(t1);
@@ -777,7 +777,7 @@ hopf_result solve_hopf_krylov(const S& sys, const hopf_point& guess, const hopf_
     }
     linear_seconds += since(t0);
   }
-  const internal::symmetric_hopf_problem<S>& prob = *prob_storage;
+  const internal::fixed_equilibrium_hopf_problem<S>& prob = *prob_storage;
   const vec<double>& s = prob.s;
   auto residual = [&](const vec<double>& y) {
     const auto t0 = clock::now();

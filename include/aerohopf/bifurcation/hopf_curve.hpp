@@ -259,7 +259,7 @@ hopf_curve_result trace_hopf_curve(const F& family, double nu0, const hopf_point
   internal::check_curve_options(opt, lab);
   require(nu0 >= opt.nu_min && nu0 <= opt.nu_max, lab, ": nu0 = ", nu0, " outside [nu_min, nu_max]");
   require(direction == 1 || direction == -1, lab, ": direction must be +1 or -1");
-  require(!opt.start.symmetric, lab, ": the symmetric Hopf system is not supported (w depends on nu)");
+  require(!opt.start.fixed_equilibrium, lab, ": the fixed-equilibrium Hopf system is not supported (w depends on nu)");
 
   hopf_curve_result res;
   // ---- converge the start at fixed nu0 ----

@@ -15,7 +15,7 @@
 //              s.p_r
 //              s.p_i - 1
 //              c.(y - y_pred) ]                     y = (mu, nu, omega),  c_j = t_j / sigma_j^2
-// (the symmetric Hopf system of hopf_bordered.hpp at w = w0(nu), plus the pseudo-arclength row
+// (the fixed-equilibrium Hopf system of hopf_bordered.hpp at w = w0(nu), plus the pseudo-arclength row
 // in the scaled (mu, nu, omega) metric of hopf_curve.hpp). A p is evaluated exactly and matrix-
 // free (jacobian_product: a taylor pass through the residual), so every point satisfies the
 // exact equations to the Newton tolerance, whatever the approximations below.
@@ -62,7 +62,7 @@
 // linear extrapolation), one dw0/dnu solve, assembly of A, L, A_mu, one complex BILU(k), four
 // taylor products for G_nu, one GMRES on J.
 //
-// Joint corrector (symmetric_hopf_curve_options::joint_equilibrium). The nested solve above
+// Joint corrector (fixed_equilibrium_hopf_curve_options::joint_equilibrium). The nested solve above
 // converges w0(nu) at every nu the corrector visits, though only the last one matters. The joint
 // corrector makes w an unknown beside x = (p, mu, nu, omega) and solves [G(x, w); f(w, mu; nu)] = 0
 // by Newton, each step by block elimination of the flow rows (f_w dw + f_nu dnu = -f):
@@ -122,8 +122,8 @@
 // tangent after a failed secant step, the sheet-jump guard (corrector_distance, min_cosine),
 // stops (max_points, nu/mu bounds landed exactly, Bogdanov-Takens, closed curve), landing on
 // nu_targets, observer per accepted point, throw_on_failure = false. opt.start (hopf_options)
-// converges the start at nu0 with solve_hopf_krylov (symmetric forced). Per-point costs (GMRES
-// iterations, steady solves) are returned alongside in symmetric_hopf_curve_result::stats.
+// converges the start at nu0 with solve_hopf_krylov (fixed equilibrium forced). Per-point costs (GMRES
+// iterations, steady solves) are returned alongside in fixed_equilibrium_hopf_curve_result::stats.
 // Post-checks and failure reports as hopf_curve.hpp, with the equilibrium check of the fixed
 // equilibrium: the w0(nu*) a converged corrector used must satisfy ||f(w0, mu*)|| <=
 // ||f(w0, mu_solved)|| + steady.abs_tolerance (it was solved at mu_solved; a family whose
@@ -159,8 +159,8 @@
 
 namespace aerohopf {
 
-/// Costs of one accepted point of the symmetric tracer (parallel to hopf_curve_result::points).
-struct symmetric_hopf_curve_stats {
+/// Costs of one accepted point of the fixed-equilibrium tracer (parallel to hopf_curve_result::points).
+struct fixed_equilibrium_hopf_curve_stats {
   long linear_iterations = 0;   ///< GMRES iterations of the corrector(s) and tangents (Hopf system)
   int steady_solves = 0;        ///< nested steady Newton solves (new nu values)
   int steady_iterations = 0;    ///< their Newton iterations
@@ -168,8 +168,8 @@ struct symmetric_hopf_curve_stats {
   double steady_seconds = 0;    ///< wall time in the nested steady solves and dw0/dnu
 };
 
-struct symmetric_hopf_curve_result : hopf_curve_result {
-  std::vector<symmetric_hopf_curve_stats> stats;  ///< one per point, including failed attempts
+struct fixed_equilibrium_hopf_curve_result : hopf_curve_result {
+  std::vector<fixed_equilibrium_hopf_curve_stats> stats;  ///< one per point, including failed attempts
   int kink_steps = 0;                   ///< steps taken at fixed mu or nu (kink_fallback)
   long linear_iterations = 0;
   int steady_solves = 0;
@@ -177,9 +177,9 @@ struct symmetric_hopf_curve_result : hopf_curve_result {
   double steady_seconds = 0;
 };
 
-/// Linear algebra and nested steady solves of trace_symmetric_hopf_curve (the curve options
+/// Linear algebra and nested steady solves of trace_fixed_equilibrium_hopf_curve (the curve options
 /// are those of hopf_curve_options).
-struct symmetric_hopf_curve_options {
+struct fixed_equilibrium_hopf_curve_options {
   int fill_level = 1;  ///< k of the complex BILU(k) of L - i omega I and of the real BILU(k) of L
   krylov_options krylov = [] {
     krylov_options o;
@@ -226,19 +226,19 @@ struct symmetric_hopf_curve_options {
   /// failed, 24 steady Newton iterations). Infinity: off.
   double iterate_distance = 5.0;
   /// Called for every accepted point with its costs (after hopf_curve_options::observer).
-  std::function<void(const hopf_curve_point&, const symmetric_hopf_curve_stats&)> observer;
+  std::function<void(const hopf_curve_point&, const fixed_equilibrium_hopf_curve_stats&)> observer;
 };
 
-/// Traces the symmetric Hopf curve of family(nu) through the Hopf point `start` of family(nu0)
+/// Traces the fixed-equilibrium Hopf curve of family(nu) through the Hopf point `start` of family(nu0)
 /// (a guess: start.w an approximate equilibrium at nu0, polished by the nested steady Newton;
 /// then (p, mu, omega) converged by solve_hopf_krylov<B> at fixed nu0), initially towards
 /// increasing (direction = +1) or decreasing (-1) nu. B: block size of the unknowns for BILU
 /// (4 for 2D Euler + pitch-plunge). See the file comment.
 template <int B, system_family F>
   requires is_sparse_matrix_v<jacobian_t<family_system_t<F>>>
-symmetric_hopf_curve_result trace_symmetric_hopf_curve(const F& family, double nu0, const hopf_point& start,
+fixed_equilibrium_hopf_curve_result trace_fixed_equilibrium_hopf_curve(const F& family, double nu0, const hopf_point& start,
                                                        const hopf_curve_options& opt = {}, int direction = +1,
-                                                       const symmetric_hopf_curve_options& sopt = {}) {
+                                                       const fixed_equilibrium_hopf_curve_options& sopt = {}) {
   using S = family_system_t<F>;
   using M = jacobian_t<S>;
   using C = std::complex<double>;
@@ -270,8 +270,8 @@ symmetric_hopf_curve_result trace_symmetric_hopf_curve(const F& family, double n
   require(std::isfinite(sopt.kink_distance) && sopt.kink_distance > 0, lab,
           ": kink_distance must be finite and > 0 (got ", sopt.kink_distance, ")");
 
-  symmetric_hopf_curve_result res;
-  symmetric_hopf_curve_stats acc;  // costs since the last accepted point
+  fixed_equilibrium_hopf_curve_result res;
+  fixed_equilibrium_hopf_curve_stats acc;  // costs since the last accepted point
   internal::family_cache<F, S> cur(family), plus(family), minus(family);
   Eigen::Index n = 0;
   {
@@ -572,7 +572,7 @@ symmetric_hopf_curve_result trace_symmetric_hopf_curve(const F& family, double n
       throw convergence_error(internal::concat(lab, " ", who, ": iterate at nu = ", x[inu], ", mu = ", x[imu], " lies ",
                                                d, " from the prediction (more than ", radius, ")"));
   };
-  // Joint corrector (symmetric_hopf_curve_options::joint_equilibrium, file comment): Newton on
+  // Joint corrector (fixed_equilibrium_hopf_curve_options::joint_equilibrium, file comment): Newton on
   // [x; w] with f(w, mu; nu) = 0 as n more equations (scaled so that the Hopf tolerance on the
   // whole residual is the steady tolerance on f), each step by block elimination.
   auto correct_joint = [&](const vec<double>& x0, const vec<double>& s, const double* c, double value,
@@ -727,17 +727,17 @@ symmetric_hopf_curve_result trace_symmetric_hopf_curve(const F& family, double n
   };
   auto seconds_since = [](clock::time_point t) { return std::chrono::duration<double>(clock::now() - t).count(); };
 
-  // ---- the start: equilibrium at nu0, then the symmetric Hopf point there ----
+  // ---- the start: equilibrium at nu0, then the fixed-equilibrium Hopf point there ----
   const auto t_start = clock::now();
   hopf_result h0;
   {
-    check_state(system_at(cur, nu0), start.w, start.mu, "trace_symmetric_hopf_curve");
+    check_state(system_at(cur, nu0), start.w, start.mu, "trace_fixed_equilibrium_hopf_curve");
     vec<double> w0 = steady_solve(nu0, start.mu, start.w);
     cache.push_back({nu0, w0, vec<double>(), start.mu});
     hopf_point g = start;
     g.w = std::move(w0);
     hopf_options ho = opt.start;
-    ho.symmetric = true;
+    ho.fixed_equilibrium = true;
     ho.normalisation = opt.normalisation;
     // the equilibrium holds to what the nested steady solve reached (post-checks, hopf.hpp)
     ho.equilibrium_tolerance = std::max(
@@ -936,7 +936,7 @@ symmetric_hopf_curve_result trace_symmetric_hopf_curve(const F& family, double n
       const int iters = xn->iterations;
       const double step_seconds = seconds_since(t_point);
       // costs of this step, kept apart from those of landings emitted before xnew
-      const symmetric_hopf_curve_stats step_costs = std::exchange(acc, symmetric_hopf_curve_stats{});
+      const fixed_equilibrium_hopf_curve_stats step_costs = std::exchange(acc, fixed_equilibrium_hopf_curve_stats{});
       auto add_step_costs = [&] {
         acc.linear_iterations += step_costs.linear_iterations;
         acc.steady_solves += step_costs.steady_solves;

@@ -1,5 +1,5 @@
-// The Krylov tracer of the symmetric Hopf curve with nested steady solves, and with the joint
-// corrector (hopf_curve_symmetric.hpp), checked against independent references:
+// The Krylov tracer of the fixed-equilibrium Hopf curve with nested steady solves, and with the joint
+// corrector (hopf_curve_fixed_equilibrium.hpp), checked against independent references:
 //  * a synthetic family whose equilibrium w*(nu) depends on nu but not on mu and whose Hopf
 //    curve is the unit circle mu^2 + nu^2 = 1 (omega = 1 + 0.3 mu), so it turns in nu at nu = 1
 //    (dnu/ds = 0, where the fixed-nu Hopf Jacobian is singular): closed form, the dense spectrum
@@ -146,12 +146,12 @@ double seconds_since(std::chrono::steady_clock::time_point t) {
 
 }  // namespace
 
-TEST(hopf_curve_symmetric, circle_through_the_turning_point_in_nu) {
+TEST(hopf_curve_fixed_equilibrium, circle_through_the_turning_point_in_nu) {
   auto family = [](double nu) { return circle_family_system(nu); };
   const double nu0 = 0.6;
   const auto t0 = std::chrono::steady_clock::now();
-  const symmetric_hopf_curve_result r =
-      trace_symmetric_hopf_curve<2>(family, nu0, circle_start(nu0, 0.78, 1.2), circle_options(), +1);
+  const fixed_equilibrium_hopf_curve_result r =
+      trace_fixed_equilibrium_hopf_curve<2>(family, nu0, circle_start(nu0, 0.78, 1.2), circle_options(), +1);
   std::cout << "symmetric circle: " << r.points.size() << " points, " << r.failed_correctors << " failed correctors, "
             << r.linear_iterations << " GMRES iterations, " << r.steady_solves << " steady solves, "
             << seconds_since(t0) << " s; " << r.stop_reason << "\n";
@@ -196,14 +196,14 @@ TEST(hopf_curve_symmetric, circle_through_the_turning_point_in_nu) {
 // The joint corrector (w an unknown of the corrector, one flow Newton step per iteration) on the
 // same circle: the same closed-form checks, the nested tracer's landed points, no nested steady
 // solve after the start, and fewer flow Newton steps than the nested solves took.
-TEST(hopf_curve_symmetric, joint_corrector_traces_the_same_circle_without_nested_steady_solves) {
+TEST(hopf_curve_fixed_equilibrium, joint_corrector_traces_the_same_circle_without_nested_steady_solves) {
   auto family = [](double nu) { return circle_family_system(nu); };
   const double nu0 = 0.6;
-  symmetric_hopf_curve_options joint;
+  fixed_equilibrium_hopf_curve_options joint;
   joint.joint_equilibrium = true;
-  const auto r = trace_symmetric_hopf_curve<2>(family, nu0, circle_start(nu0, 0.78, 1.2), circle_options(), +1, joint);
-  const auto nested = trace_symmetric_hopf_curve<2>(family, nu0, circle_start(nu0, 0.78, 1.2), circle_options(), +1);
-  auto flow_steps = [](const symmetric_hopf_curve_result& q) {
+  const auto r = trace_fixed_equilibrium_hopf_curve<2>(family, nu0, circle_start(nu0, 0.78, 1.2), circle_options(), +1, joint);
+  const auto nested = trace_fixed_equilibrium_hopf_curve<2>(family, nu0, circle_start(nu0, 0.78, 1.2), circle_options(), +1);
+  auto flow_steps = [](const fixed_equilibrium_hopf_curve_result& q) {
     int newton = 0;
     for (const auto& pt : q.points) newton += pt.newton_iterations;
     return std::pair{q.steady_iterations, newton};
@@ -245,7 +245,7 @@ TEST(hopf_curve_symmetric, joint_corrector_traces_the_same_circle_without_nested
   o.nu_max = 0.8;
   o.min_step = 1e-4;
   o.verbose = false;
-  const auto k = trace_symmetric_hopf_curve<2>(kinked, 0.6, circle_start(0.6, 0.78, 1.2), o, 1, joint);
+  const auto k = trace_fixed_equilibrium_hopf_curve<2>(kinked, 0.6, circle_start(0.6, 0.78, 1.2), o, 1, joint);
   EXPECT_EQ(k.stop, hopf_curve_stop::nu_bounds);
   const hopf_curve_point* at = nullptr;
   for (const auto& pt : k.points)
@@ -254,14 +254,14 @@ TEST(hopf_curve_symmetric, joint_corrector_traces_the_same_circle_without_nested
   EXPECT_NEAR(at->mu, std::sqrt(1 - 0.5625 + 0.25), 1e-9);
 }
 
-TEST(hopf_curve_symmetric, decreasing_direction_lands_on_the_lower_bound) {
+TEST(hopf_curve_fixed_equilibrium, decreasing_direction_lands_on_the_lower_bound) {
   auto family = [](double nu) { return circle_family_system(nu); };
   hopf_curve_options o = circle_options();
   o.nu_min = 0.3;
   o.nu_targets = {};
   o.mu_min = -std::numeric_limits<double>::infinity();
   o.verbose = false;
-  const auto r = trace_symmetric_hopf_curve<2>(family, 0.6, circle_start(0.6, 0.78, 1.2), o, -1);
+  const auto r = trace_fixed_equilibrium_hopf_curve<2>(family, 0.6, circle_start(0.6, 0.78, 1.2), o, -1);
   EXPECT_EQ(r.stop, hopf_curve_stop::nu_bounds);
   ASSERT_GE(r.points.size(), 3u);
   EXPECT_NEAR(r.points.back().nu, 0.3, 1e-13);
@@ -272,7 +272,7 @@ TEST(hopf_curve_symmetric, decreasing_direction_lands_on_the_lower_bound) {
 // stop_after ends the trace at the first accepted point it returns true for: here the first
 // point past the turning point nu = 1 of the circle (nu decreasing again), i.e. where a caller
 // that needs a boundary single-valued in nu hands over. Both tracers.
-TEST(hopf_curve_symmetric, stop_after_ends_the_trace_where_the_caller_asks) {
+TEST(hopf_curve_fixed_equilibrium, stop_after_ends_the_trace_where_the_caller_asks) {
   auto family = [](double nu) { return circle_family_system(nu); };
   hopf_curve_options o = circle_options();
   o.verbose = false;
@@ -283,7 +283,7 @@ TEST(hopf_curve_symmetric, stop_after_ends_the_trace_where_the_caller_asks) {
     nu_hi = std::max(nu_hi, p.nu);
     return p.nu < nu_hi - 1e-3;
   };
-  const auto r = trace_symmetric_hopf_curve<2>(family, 0.6, circle_start(0.6, 0.78, 1.2), o, +1);
+  const auto r = trace_fixed_equilibrium_hopf_curve<2>(family, 0.6, circle_start(0.6, 0.78, 1.2), o, +1);
   EXPECT_EQ(r.stop, hopf_curve_stop::requested);
   ASSERT_GE(r.points.size(), 3u);
   EXPECT_EQ(calls, static_cast<int>(r.points.size()));  // every accepted point, the stopping one last
@@ -303,7 +303,7 @@ TEST(hopf_curve_symmetric, stop_after_ends_the_trace_where_the_caller_asks) {
 
 // A kink of the curve at nu = 0.7 where it turns by ~117 degrees in the metric: the arclength
 // corrector cannot cross it at any step size; the fixed-nu fallback does.
-TEST(hopf_curve_symmetric, crosses_a_kink_at_fixed_nu) {
+TEST(hopf_curve_fixed_equilibrium, crosses_a_kink_at_fixed_nu) {
   auto family = [](double nu) { return circle_family_system(nu, 5.0); };
   hopf_curve_options o = circle_options();
   o.nu_targets = {0.75};
@@ -311,7 +311,7 @@ TEST(hopf_curve_symmetric, crosses_a_kink_at_fixed_nu) {
   o.nu_max = 0.8;
   o.min_step = 1e-4;
   o.verbose = false;
-  const auto r = trace_symmetric_hopf_curve<2>(family, 0.6, circle_start(0.6, 0.78, 1.2), o);
+  const auto r = trace_fixed_equilibrium_hopf_curve<2>(family, 0.6, circle_start(0.6, 0.78, 1.2), o);
   std::cout << "kink: " << r.points.size() << " points, " << r.kink_steps << " fixed-parameter steps, "
             << r.failed_correctors << " failed correctors; " << r.stop_reason << "\n";
   EXPECT_EQ(r.stop, hopf_curve_stop::nu_bounds);
@@ -327,42 +327,42 @@ TEST(hopf_curve_symmetric, crosses_a_kink_at_fixed_nu) {
   EXPECT_NEAR(at->mu, std::sqrt(1 - 0.5625 + 0.25), 1e-9);
   EXPECT_NEAR(at->omega, 1 + 0.3 * at->mu, 1e-9);
   // without the fallback the trace stops at the kink
-  symmetric_hopf_curve_options so;
+  fixed_equilibrium_hopf_curve_options so;
   so.kink_fallback = false;
   o.throw_on_failure = false;
-  const auto stuck = trace_symmetric_hopf_curve<2>(family, 0.6, circle_start(0.6, 0.78, 1.2), o, 1, so);
+  const auto stuck = trace_fixed_equilibrium_hopf_curve<2>(family, 0.6, circle_start(0.6, 0.78, 1.2), o, 1, so);
   EXPECT_EQ(stuck.stop, hopf_curve_stop::step_failure);
   EXPECT_LT(stuck.points.back().nu, 0.7 + 1e-3);
 }
 
-TEST(hopf_curve_symmetric, refuses_bad_input_and_reports_step_failure) {
+TEST(hopf_curve_fixed_equilibrium, refuses_bad_input_and_reports_step_failure) {
   auto family = [](double nu) { return circle_family_system(nu); };
   const hopf_point start = circle_start(0.6, 0.78, 1.2);
   hopf_curve_options o = circle_options();
   o.verbose = false;
-  EXPECT_THROW(trace_symmetric_hopf_curve<2>(family, 0.6, start, o, 0), input_error);
-  EXPECT_THROW(trace_symmetric_hopf_curve<2>(family, NAN, start, o), input_error);
+  EXPECT_THROW(trace_fixed_equilibrium_hopf_curve<2>(family, 0.6, start, o, 0), input_error);
+  EXPECT_THROW(trace_fixed_equilibrium_hopf_curve<2>(family, NAN, start, o), input_error);
   hopf_curve_options bad = o;
   bad.step = 0;
-  EXPECT_THROW(trace_symmetric_hopf_curve<2>(family, 0.6, start, bad), input_error);
+  EXPECT_THROW(trace_fixed_equilibrium_hopf_curve<2>(family, 0.6, start, bad), input_error);
   bad = o;
   bad.nu_min = 0.7;
-  EXPECT_THROW(trace_symmetric_hopf_curve<2>(family, 0.6, start, bad), input_error);
+  EXPECT_THROW(trace_fixed_equilibrium_hopf_curve<2>(family, 0.6, start, bad), input_error);
   hopf_point short_p = start;
   short_p.p = short_p.p.head(3).eval();
-  EXPECT_THROW(trace_symmetric_hopf_curve<2>(family, 0.6, short_p, o), input_error);
+  EXPECT_THROW(trace_fixed_equilibrium_hopf_curve<2>(family, 0.6, short_p, o), input_error);
   hopf_point short_w = start;
   short_w.w = short_w.w.head(5).eval();
-  EXPECT_THROW(trace_symmetric_hopf_curve<2>(family, 0.6, short_w, o), input_error);
-  symmetric_hopf_curve_options so;
+  EXPECT_THROW(trace_fixed_equilibrium_hopf_curve<2>(family, 0.6, short_w, o), input_error);
+  fixed_equilibrium_hopf_curve_options so;
   so.fill_level = -1;
-  EXPECT_THROW(trace_symmetric_hopf_curve<2>(family, 0.6, start, o, 1, so), input_error);
+  EXPECT_THROW(trace_fixed_equilibrium_hopf_curve<2>(family, 0.6, start, o, 1, so), input_error);
   so = {};
   so.steady.abs_tolerance = 0;
-  EXPECT_THROW(trace_symmetric_hopf_curve<2>(family, 0.6, start, o, 1, so), input_error);
+  EXPECT_THROW(trace_fixed_equilibrium_hopf_curve<2>(family, 0.6, start, o, 1, so), input_error);
   so = {};
   so.derivative_tolerance = 1.0;
-  EXPECT_THROW(trace_symmetric_hopf_curve<2>(family, 0.6, start, o, 1, so), input_error);
+  EXPECT_THROW(trace_fixed_equilibrium_hopf_curve<2>(family, 0.6, start, o, 1, so), input_error);
 
   // A family that cannot be built beyond nu = 0.7 (a steady solve failing past some Mach number)
   auto limited = [](double nu) {
@@ -371,7 +371,7 @@ TEST(hopf_curve_symmetric, refuses_bad_input_and_reports_step_failure) {
   };
   o.min_step = 1e-3;
   try {
-    trace_symmetric_hopf_curve<2>(limited, 0.6, start, o);
+    trace_fixed_equilibrium_hopf_curve<2>(limited, 0.6, start, o);
     ADD_FAILURE() << "no convergence_error";
   } catch (const convergence_error& e) {
     const std::string m = e.what();
@@ -379,7 +379,7 @@ TEST(hopf_curve_symmetric, refuses_bad_input_and_reports_step_failure) {
     EXPECT_NE(m.find("no system beyond nu = 0.7"), std::string::npos) << m;
   }
   o.throw_on_failure = false;
-  const auto r = trace_symmetric_hopf_curve<2>(limited, 0.6, start, o);
+  const auto r = trace_fixed_equilibrium_hopf_curve<2>(limited, 0.6, start, o);
   EXPECT_EQ(r.stop, hopf_curve_stop::step_failure);
   ASSERT_GE(r.points.size(), 2u);
   EXPECT_LE(r.points.back().nu, 0.7);
@@ -390,7 +390,7 @@ TEST(hopf_curve_symmetric, refuses_bad_input_and_reports_step_failure) {
 // is abandoned before the equilibrium at its nu is solved. With a radius below the corrector's
 // first move every step fails, the trace reports why and the family is never built away from a
 // prediction; the default radius leaves the circle's trace unchanged.
-TEST(hopf_curve_symmetric, abandons_a_corrector_that_leaves_the_trust_radius) {
+TEST(hopf_curve_fixed_equilibrium, abandons_a_corrector_that_leaves_the_trust_radius) {
   std::vector<double> built;
   auto family = [&](double nu) {
     built.push_back(nu);
@@ -401,9 +401,9 @@ TEST(hopf_curve_symmetric, abandons_a_corrector_that_leaves_the_trust_radius) {
   o.verbose = false;
   o.throw_on_failure = false;
   o.min_step = 0.05;
-  symmetric_hopf_curve_options so;
+  fixed_equilibrium_hopf_curve_options so;
   so.iterate_distance = 1e-9;
-  const auto r = trace_symmetric_hopf_curve<2>(family, 0.6, start, o, 1, so);
+  const auto r = trace_fixed_equilibrium_hopf_curve<2>(family, 0.6, start, o, 1, so);
   EXPECT_EQ(r.stop, hopf_curve_stop::step_failure);
   EXPECT_EQ(r.points.size(), 1u);
   EXPECT_NE(r.stop_reason.find("from the prediction (more than"), std::string::npos) << r.stop_reason;
@@ -411,19 +411,19 @@ TEST(hopf_curve_symmetric, abandons_a_corrector_that_leaves_the_trust_radius) {
   // only the start and the predictions were built: each lies within one step of nu0 = 0.6
   for (double nu : built) EXPECT_LE(std::abs(nu - 0.6), o.step * o.nu_scale + 1e-12) << nu;
   built.clear();
-  const auto same = trace_symmetric_hopf_curve<2>(family, 0.6, start, o, 1, symmetric_hopf_curve_options{});
+  const auto same = trace_fixed_equilibrium_hopf_curve<2>(family, 0.6, start, o, 1, fixed_equilibrium_hopf_curve_options{});
   so = {};
   so.iterate_distance = std::numeric_limits<double>::infinity();
-  const auto off = trace_symmetric_hopf_curve<2>(family, 0.6, start, o, 1, so);
+  const auto off = trace_fixed_equilibrium_hopf_curve<2>(family, 0.6, start, o, 1, so);
   ASSERT_EQ(same.points.size(), off.points.size());
   for (std::size_t k = 0; k < same.points.size(); ++k) EXPECT_EQ(same.points[k].nu, off.points[k].nu) << k;
   so.iterate_distance = 0;
-  EXPECT_THROW(trace_symmetric_hopf_curve<2>(family, 0.6, start, o, 1, so), input_error);
+  EXPECT_THROW(trace_fixed_equilibrium_hopf_curve<2>(family, 0.6, start, o, 1, so), input_error);
 }
 
 // Heavy case (mu_s = 100) on the very coarse grid (stride 8, as the example), from M = 0.78 to
 // the landed point at M = 0.79.
-TEST(hopf_curve_symmetric, aerofoil_heavy_very_coarse_matches_fixed_mach_hopf_solve) {
+TEST(hopf_curve_fixed_equilibrium, aerofoil_heavy_very_coarse_matches_fixed_mach_hopf_solve) {
   using models::aerofoil_system;
   const auto make = test_support::heavy_very_coarse_aerofoil;
   const double m0 = 0.78, m1 = 0.79;
@@ -445,7 +445,7 @@ TEST(hopf_curve_symmetric, aerofoil_heavy_very_coarse_matches_fixed_mach_hopf_so
   o.fast_iterations = 4;
   o.verbose = true;
   o.label = "heavy very coarse";
-  const auto r = trace_symmetric_hopf_curve<4>(make, m0, guess, o);
+  const auto r = trace_fixed_equilibrium_hopf_curve<4>(make, m0, guess, o);
   std::cout << "aerofoil: " << r.points.size() << " points in " << seconds_since(t0) << " s, stop: " << r.stop_reason
             << "\n";
   const hopf_curve_point* at = nullptr;
@@ -464,7 +464,7 @@ TEST(hopf_curve_symmetric, aerofoil_heavy_very_coarse_matches_fixed_mach_hopf_so
   const vec<double> w1 = s1.steady_equilibrium(so);
   EXPECT_LT((at->w - w1).lpNorm<Eigen::Infinity>(), 1e-8);
   hopf_options ho;
-  ho.symmetric = true;
+  ho.fixed_equilibrium = true;
   hopf_point g = at->point();
   g.w = w1;
   g.mu *= 1.01;
@@ -478,10 +478,10 @@ TEST(hopf_curve_symmetric, aerofoil_heavy_very_coarse_matches_fixed_mach_hopf_so
   EXPECT_NEAR(std::abs(at->mu), 3.5379158790270173, 1e-7);
   EXPECT_NEAR(at->omega, 0.23343358002885775, 1e-7);
   // the joint corrector (flow as an unknown of the corrector) lands on the same point
-  symmetric_hopf_curve_options joint;
+  fixed_equilibrium_hopf_curve_options joint;
   joint.joint_equilibrium = true;
   o.label = "heavy very coarse joint";
-  const auto rj = trace_symmetric_hopf_curve<4>(make, m0, guess, o, +1, joint);
+  const auto rj = trace_fixed_equilibrium_hopf_curve<4>(make, m0, guess, o, +1, joint);
   const hopf_curve_point* atj = nullptr;
   std::size_t kj = 0;
   for (std::size_t k = 0; k < rj.points.size(); ++k)
@@ -520,13 +520,13 @@ const hopf_curve_point* landed_at(const std::vector<hopf_curve_point>& pts, doub
 }
 }  // namespace
 
-TEST(hopf_curve_symmetric_hostile, options_are_checked_by_name) {
+TEST(hopf_curve_fixed_equilibrium_hostile, options_are_checked_by_name) {
   auto family = [](double nu) { return circle_family_system(nu); };
   const hopf_point start = circle_start(0.6, 0.78, 1.2);
-  auto message = [&](const hopf_curve_options& o, const symmetric_hopf_curve_options& so,
+  auto message = [&](const hopf_curve_options& o, const fixed_equilibrium_hopf_curve_options& so,
                      const hopf_point& s) -> std::string {
     try {
-      trace_symmetric_hopf_curve<2>(family, 0.6, s, o, 1, so);
+      trace_fixed_equilibrium_hopf_curve<2>(family, 0.6, s, o, 1, so);
     } catch (const input_error& e) {
       return e.what();
     } catch (const std::exception& e) {
@@ -535,8 +535,8 @@ TEST(hopf_curve_symmetric_hostile, options_are_checked_by_name) {
     return "no exception";
   };
   const hopf_curve_options good = quiet_circle_options();
-  const symmetric_hopf_curve_options sgood;
-  auto expect = [&](const hopf_curve_options& o, const symmetric_hopf_curve_options& so, const hopf_point& s,
+  const fixed_equilibrium_hopf_curve_options sgood;
+  auto expect = [&](const hopf_curve_options& o, const fixed_equilibrium_hopf_curve_options& so, const hopf_point& s,
                     const char* part) {
     const std::string m = message(o, so, s);
     EXPECT_NE(m.find(part), std::string::npos) << part << " not in: " << m;
@@ -553,7 +553,7 @@ TEST(hopf_curve_symmetric_hostile, options_are_checked_by_name) {
   o = good;
   o.start.newton.abs_tolerance = NAN;
   expect(o, sgood, start, "newton.abs_tolerance");
-  symmetric_hopf_curve_options so = sgood;
+  fixed_equilibrium_hopf_curve_options so = sgood;
   so.kink_distance = 0;
   expect(good, so, start, "kink_distance");
   so = sgood;
@@ -570,13 +570,13 @@ TEST(hopf_curve_symmetric_hostile, options_are_checked_by_name) {
 // A family whose equilibrium moves with mu: the symmetric tracer's fixed-equilibrium Hopf
 // system cannot follow it; the start point is refused (the equilibrium solved at the guess's mu
 // does not hold at mu*) instead of tracing a curve of non-equilibria.
-TEST(hopf_curve_symmetric_hostile, an_equilibrium_that_moves_with_mu_is_refused) {
+TEST(hopf_curve_fixed_equilibrium_hostile, an_equilibrium_that_moves_with_mu_is_refused) {
   const vec<double> c = vec<double>::LinSpaced(circle_family_system::n, 0.2, -0.3);
   auto family = [c](double nu) { return mu_shifted_system<circle_family_system>(circle_family_system(nu), c); };
   hopf_point start = circle_start(0.6, 0.78, 1.2);
   start.w += c * start.mu;
   try {
-    const auto r = trace_symmetric_hopf_curve<2>(family, 0.6, start, quiet_circle_options());
+    const auto r = trace_fixed_equilibrium_hopf_curve<2>(family, 0.6, start, quiet_circle_options());
     ADD_FAILURE() << "traced " << r.points.size() << " points of a moving equilibrium";
   } catch (const convergence_error& e) {
     EXPECT_NE(std::string(e.what()).find("equilibrium does not hold"), std::string::npos) << e.what();
@@ -587,7 +587,7 @@ TEST(hopf_curve_symmetric_hostile, an_equilibrium_that_moves_with_mu_is_refused)
 // so far, the reason names the tracer, the point and the corrector's last accepted iterate;
 // restarted from the last point without the fault, it lands on the same point as the
 // uninjected trace. A single NaN is survived (same landed point).
-TEST(hopf_curve_symmetric_hostile, nan_residual_stops_with_context_and_the_trace_restarts) {
+TEST(hopf_curve_fixed_equilibrium_hostile, nan_residual_stops_with_context_and_the_trace_restarts) {
   const hopf_point start = circle_start(0.6, 0.78, 1.2);
   const hopf_point start_copy = start;
   hopf_curve_options o = quiet_circle_options();
@@ -599,14 +599,14 @@ TEST(hopf_curve_symmetric_hostile, nan_residual_stops_with_context_and_the_trace
   counting.observer = [&](const hopf_curve_point&) {
     if (++seen == 3) calls_at_point2 = *clean;
   };
-  const auto ref = trace_symmetric_hopf_curve<2>(faulty_circle_family(clean, 1L << 40, 0), 0.6, start, counting);
+  const auto ref = trace_fixed_equilibrium_hopf_curve<2>(faulty_circle_family(clean, 1L << 40, 0), 0.6, start, counting);
   const hopf_curve_point* ref_land = landed_at(ref.points, 0.8, +1);
   ASSERT_NE(ref_land, nullptr);
   ASSERT_GT(calls_at_point2, 0);
   ASSERT_LT(ref.points[2].nu, 0.8);
 
   auto once = std::make_shared<long>(0);
-  const auto survived = trace_symmetric_hopf_curve<2>(faulty_circle_family(once, calls_at_point2 + 3, 1), 0.6, start, o);
+  const auto survived = trace_fixed_equilibrium_hopf_curve<2>(faulty_circle_family(once, calls_at_point2 + 3, 1), 0.6, start, o);
   const hopf_curve_point* s_land = landed_at(survived.points, 0.8, +1);
   ASSERT_NE(s_land, nullptr);
   EXPECT_NEAR(s_land->mu, ref_land->mu, 1e-9);
@@ -614,7 +614,7 @@ TEST(hopf_curve_symmetric_hostile, nan_residual_stops_with_context_and_the_trace
 
   o.throw_on_failure = false;
   auto counter = std::make_shared<long>(0);
-  const auto r = trace_symmetric_hopf_curve<2>(faulty_circle_family(counter, calls_at_point2 + 1, 1L << 40), 0.6, start, o);
+  const auto r = trace_fixed_equilibrium_hopf_curve<2>(faulty_circle_family(counter, calls_at_point2 + 1, 1L << 40), 0.6, start, o);
   EXPECT_EQ(r.stop, hopf_curve_stop::step_failure);
   ASSERT_EQ(r.points.size(), 3u);
   for (const char* part : {"injected symmetric curve", "point 2", "last accepted iterate", "||F|| = ", "nu = ", "mu = ",
@@ -626,7 +626,7 @@ TEST(hopf_curve_symmetric_hostile, nan_residual_stops_with_context_and_the_trace
   o.throw_on_failure = true;
   auto family = [](double nu) { return circle_family_system(nu); };
   const hopf_curve_point& last = r.points.back();
-  const auto again = trace_symmetric_hopf_curve<2>(family, last.nu, last.point(), o);
+  const auto again = trace_fixed_equilibrium_hopf_curve<2>(family, last.nu, last.point(), o);
   const hopf_curve_point* land = landed_at(again.points, 0.8, +1);
   ASSERT_NE(land, nullptr);
   EXPECT_NEAR(land->mu, ref_land->mu, 1e-9);
