@@ -58,21 +58,16 @@ using namespace aerofoil_example;
 
 namespace aerofoil_example {
 
-/// The driver's options for this problem: the start guess of the case, the tracer's step
-/// metric for the hand-over (setup.hpp), mu = Ubar entering as 1/Ubar^2.
+/// The driver's options: the family's (aerofoil_family::boundary_options) with the case's start
+/// guess and the user's choices.
 flutter_boundary_options driver_options(const options& o, const structural_case& c, const grid_level& g,
-                                        const std::vector<double>& machs) {
-  flutter_boundary_options fo;
+                                        const models::aerofoil_family& family) {
+  flutter_boundary_options fo = family.boundary_options();
   fo.start_mu = c.ubar_guess;
   fo.start_omega = c.omega_guess;
   fo.fill_level = o.fill;
-  fo.parameter_even = true;  // Ubar enters only through 1/Ubar^2, also at incidence
-  fo.moving_equilibrium = o.incidence_deg != 0.0;
   fo.verbose = o.verbose;
   fo.label = c.name + " " + g.name;
-  const tracer_options t = aerofoil_tracer_options(g, c, machs.front(), machs.back(), o.fill);
-  fo.curve = t.curve;
-  fo.fixed_equilibrium = t.fixed_equilibrium;
   // the crossing check factorises i omega I - A_ff at every sampled frequency: ~1 s per LU on
   // the medium grid, so there only with --crossing-medium
   fo.check_crossings = o.jump_check && (g.stride >= 4 || (g.stride == 2 && o.crossing_medium));
@@ -83,7 +78,7 @@ flutter_boundary boundary_on(const options& o, const structural_case& c, const g
                              const flutter_boundary* coarser) {
   const auto machs = mach_list(o);
   const auto family = family_of(c, o.incidence_deg * std::numbers::pi / 180);
-  flutter_boundary b = trace_flutter_boundary(family, g.stride, machs, coarser, driver_options(o, c, g, machs));
+  flutter_boundary b = trace_flutter_boundary(family, g.stride, machs, coarser, driver_options(o, c, g, family));
   const bool moving = o.incidence_deg != 0.0;
   char tag[64] = "";
   if (moving) std::snprintf(tag, sizeof tag, "_alpha%g", o.incidence_deg);

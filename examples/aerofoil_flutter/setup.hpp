@@ -3,7 +3,7 @@
 // levels (every stride-th point of the fine NACA 0012 C-grid), the two structural cases of
 // spec 05, the coupled system at a Mach number, and the timed steady solve from the free
 // stream (the unit of cost the examples report), and the options of the fixed-equilibrium Hopf-curve
-// tracer for this problem.
+// tracer for aerofoil_branch.
 #include <aerohopf/bifurcation/hopf_curve_fixed_equilibrium.hpp>
 #include <aerohopf/error.hpp>
 #include <aerohopf/flow/naca_cgrid.hpp>
@@ -97,13 +97,6 @@ inline steady_result steady(const aerofoil_system& s) {
   return r;
 }
 
-/// Options of trace_fixed_equilibrium_hopf_curve (bifurcation/hopf_curve_fixed_equilibrium.hpp) for the aerofoil,
-/// shared by aerofoil_branch and the hand-over of natural continuation in aerofoil_flutter.
-/// Metric: Ubar / mu_scale, M / nu_scale, omega / omega_scale (default 0.5, 0.01, 0.05: a step
-/// of 1 is at most 0.01 in M); steps 0.5 .. max_step, down to 1e-3; Ubar in [0.2, 20]; M in
-/// [m0, m_max] with every M = 0.01 k landed exactly; 8 Newton iterations per corrector (3-5
-/// quadratic steps when it converges: fail fast at kinks); BILU(fill); nested steady Newton to
-/// ||f|| <= 1e-10, its third start the pseudo-transient solve from the free stream.
 /// The value of --tracer-corrector / --corrector: true for "joint"
 /// (fixed_equilibrium_hopf_curve_options::joint_equilibrium), false for "nested".
 inline bool joint_corrector(const std::string& value, const std::string& option) {
@@ -111,47 +104,33 @@ inline bool joint_corrector(const std::string& value, const std::string& option)
   return value == "joint";
 }
 
+/// Options of trace_fixed_equilibrium_hopf_curve for aerofoil_branch: the family's
+/// (aerofoil_family::boundary_options) with the user's metric scales and largest step, M in
+/// [m0, m_max] with every M = 0.01 k landed exactly, BILU(fill), the nested steady solves'
+/// third start the pseudo-transient solve from the free stream.
 struct tracer_options {
   aerohopf::hopf_curve_options curve;
   aerohopf::fixed_equilibrium_hopf_curve_options fixed_equilibrium;
 };
 inline tracer_options aerofoil_tracer_options(const grid_level& g, const structural_case& c, double m0, double m_max,
-                                              int fill, double mu_scale = 0.5, double nu_scale = 0.01,
-                                              double omega_scale = 0.05, double max_step = 1.0) {
-  tracer_options t;
+                                              int fill, double mu_scale, double nu_scale, double omega_scale,
+                                              double max_step) {
+  const aerohopf::flutter_boundary_options b = family_of(c).boundary_options();
+  tracer_options t{b.curve, b.fixed_equilibrium};
   auto& ho = t.curve;
   ho.mu_scale = mu_scale;
   ho.nu_scale = nu_scale;
   ho.omega_scale = omega_scale;
   ho.max_step = max_step;
-  ho.step = std::min(0.5, max_step);
-  ho.min_step = 1e-3;
+  ho.step = std::min(ho.step, max_step);
   ho.nu_min = m0 - 1e-9;
   ho.nu_max = m_max;
-  ho.mu_min = 0.2;
-  ho.mu_max = 20.0;
-  ho.fast_iterations = 4;
-  ho.newton.max_iterations = 8;
-  // a corrector whose ||F|| rises after its first step is abandoned at once for the next fallback
-  // (exact tangent, fixed M or Ubar, half step): measured on the heavy medium grid near M = 0.826,
-  // all converged correctors were monotone from iteration 2 on, the failed ones rose by 1.4-2500x
-  // at iteration 2-5 and ran on to iteration 8 (each iteration a nested steady solve)
-  ho.newton.max_contraction = 1.0;
   for (int k = static_cast<int>(std::ceil(m0 * 100 + 1e-6)); k <= static_cast<int>(std::floor(m_max * 100 + 1e-6)); ++k)
     ho.nu_targets.push_back(k / 100.0);
   ho.throw_on_failure = false;
   ho.label = c.name + " " + g.name;
   ho.verbose = true;
-  ho.start.newton.max_iterations = 20;
   t.fixed_equilibrium.fill_level = fill;
-  // nested steady Newton: ||f||_2 <= 1e-10 (the default 1e-11 is at the rounding floor of the
-  // medium grid: measured, Newton stalls at 1.6e-11 there); Hopf points are converged to 1e-7
-  t.fixed_equilibrium.steady.abs_tolerance = 1e-10;
-  // dw0/dnu only sets the Jacobian column G_nu and the warm start: GMRES to 1e-4 instead of 1e-8
-  // cut the heavy medium stretch's steady + dw0/dnu GMRES iterations from 9331 to 7351 (18.5 ->
-  // 16.3 s) with the same 82 steady solves and 175 steady Newton iterations, points within the
-  // Newton tolerance (Ubar* within 1.2e-8), measured one run apart
-  t.fixed_equilibrium.derivative_tolerance = 1e-4;
   t.fixed_equilibrium.equilibrium_start = [g, mu_s = c.mu_s](double mach) { return make_system(g, mach, mu_s).steady_equilibrium(); };
   return t;
 }

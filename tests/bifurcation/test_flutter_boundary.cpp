@@ -63,30 +63,16 @@ aerofoil_family family(double mu_s) {
   return aerofoil_family(flow::naca_cgrid(), p);
 }
 
-/// The options the aerofoil example passes (examples/aerofoil_flutter: setup.hpp's tracer metric).
-flutter_boundary_options options_for(double ubar_guess, double omega_guess, const std::string& label) {
-  flutter_boundary_options o;
+/// The family's driver options (aerofoil_family::boundary_options, as the example passes them)
+/// with the case's start, silent, without the crossing checks unless asked.
+flutter_boundary_options options_for(const aerofoil_family& f, double ubar_guess, double omega_guess,
+                                     const std::string& label) {
+  flutter_boundary_options o = f.boundary_options();
   o.start_mu = ubar_guess;
   o.start_omega = omega_guess;
-  o.parameter_even = true;
   o.label = label;
   o.log = nullptr;
   o.check_crossings = false;
-  hopf_curve_options& ho = o.curve;
-  ho.mu_scale = 0.5;
-  ho.nu_scale = 0.01;
-  ho.omega_scale = 0.05;
-  ho.max_step = 1.0;
-  ho.step = 0.5;
-  ho.min_step = 1e-3;
-  ho.mu_min = 0.2;
-  ho.mu_max = 20.0;
-  ho.fast_iterations = 4;
-  ho.newton.max_iterations = 8;
-  ho.newton.max_contraction = 1.0;
-  ho.start.newton.max_iterations = 20;
-  o.fixed_equilibrium.steady.abs_tolerance = 1e-10;
-  o.fixed_equilibrium.derivative_tolerance = 1e-4;
   return o;
 }
 
@@ -106,7 +92,7 @@ void expect_matches(const flutter_boundary& b, const std::vector<reference_point
 TEST(FlutterBoundary, LightCoarseEqualsTheExamplesBoundary) {
   const auto f = family(10.0);
   const auto machs = listed_machs();
-  const flutter_boundary b = trace_flutter_boundary(f, 4, machs, nullptr, options_for(1.66, 0.75, "light coarse"));
+  const flutter_boundary b = trace_flutter_boundary(f, 4, machs, nullptr, options_for(f, 1.66, 0.75, "light coarse"));
   EXPECT_TRUE(b.complete) << b.stop_reason;
   expect_matches(b, read_reference("boundary_light_coarse.csv"));
   // attempts: every accepted point has its record, the first is the inverse-power start
@@ -124,7 +110,7 @@ TEST(FlutterBoundary, LightCoarseEqualsTheExamplesBoundary) {
 // over the steep stretch near M = 0.827 (spec 05): the driver's whole repertoire.
 TEST(FlutterBoundary, HeavyCoarseEqualsTheExamplesBoundary) {
   const auto f = family(100.0);
-  flutter_boundary_options o = options_for(4.6, 0.22, "heavy coarse");
+  flutter_boundary_options o = options_for(f, 4.6, 0.22, "heavy coarse");
   o.check_crossings = true;
   const flutter_boundary b = trace_flutter_boundary(f, 4, listed_machs(), nullptr, o);
   EXPECT_TRUE(b.complete) << b.stop_reason;
@@ -146,7 +132,7 @@ TEST(FlutterBoundary, HeavyCoarseEqualsTheExamplesBoundary) {
 TEST(FlutterBoundary, CoarsePredictorChangesStartsNotPoints) {
   const auto f = family(10.0);
   const auto machs = listed_machs(0.75);
-  const flutter_boundary_options o = options_for(1.66, 0.75, "light");
+  const flutter_boundary_options o = options_for(f, 1.66, 0.75, "light");
   const flutter_boundary vc = trace_flutter_boundary(f, 8, machs, nullptr, o);
   ASSERT_TRUE(vc.complete) << vc.stop_reason;
   flutter_boundary_options with = o, without = o;
@@ -194,6 +180,8 @@ TEST(FlutterBoundary, CostsArePureFunctionsOfThePoints) {
   EXPECT_DOUBLE_EQ(c.hopf_per_steady, (1.0 + 0.5 + 2.0 + 1.0) / (2.0 + 1.0 + 2.0 + 2.0));
   // beyond one steady solve per listed Mach number: the Hopf work and the intermediate steady solve
   EXPECT_DOUBLE_EQ(c.hopf_per_steady_listed, (1.0 + 0.5 + 2.0 + 1.0 + 1.0) / (2.0 + 2.0));
+  EXPECT_DOUBLE_EQ(c.beyond_steady_seconds, 1.0 + 0.5 + 2.0 + 1.0 + 1.0);
+  EXPECT_DOUBLE_EQ(c.listed_steady_seconds, 2.0 + 2.0);
   EXPECT_DOUBLE_EQ(c.work_seconds, 9 + 1 + 1 + 2 + 0.5 + 1 + 2 + 2 + 1);
   flutter_boundary coarse;
   coarse.points = {pt(0.5, 1.0, 0.5, true), pt(0.55, 0.5, 0.5, false)};
@@ -202,7 +190,7 @@ TEST(FlutterBoundary, CostsArePureFunctionsOfThePoints) {
 
 TEST(FlutterBoundary, BadInputIsRefused) {
   const auto f = family(10.0);
-  flutter_boundary_options o = options_for(1.66, 0.75, "bad");
+  flutter_boundary_options o = options_for(f, 1.66, 0.75, "bad");
   EXPECT_TRUE(test::contains(test::input_error_of([&] { trace_flutter_boundary(f, 8, {}, nullptr, o); }), "no Mach numbers"));
   EXPECT_TRUE(test::contains(test::input_error_of([&] { trace_flutter_boundary(f, 8, {0.6, 0.5}, nullptr, o); }),
                              "must increase"));
@@ -211,7 +199,7 @@ TEST(FlutterBoundary, BadInputIsRefused) {
   o.start_omega = -1;
   EXPECT_TRUE(test::contains(test::input_error_of([&] { trace_flutter_boundary(f, 8, {0.5}, nullptr, o); }),
                              "start_omega"));
-  o = options_for(1.66, 0.75, "bad");
+  o = options_for(f, 1.66, 0.75, "bad");
   o.same_mode_cosine = 1.5;
   EXPECT_TRUE(test::contains(test::input_error_of([&] { trace_flutter_boundary(f, 8, {0.5}, nullptr, o); }),
                              "same_mode_cosine"));

@@ -50,6 +50,7 @@
 
 #include "../error.hpp"
 #include "../linalg/krylov_solver.hpp"
+#include "../nonlinear/aeroelastic_system.hpp"
 #include "axis_crossings.hpp"
 #include "equilibrium_krylov.hpp"
 #include "hopf.hpp"
@@ -61,18 +62,20 @@ namespace aerohopf {
 
 /// A family of aeroelastic systems over grid levels and Mach numbers, what
 /// trace_flutter_boundary needs of a user's model:
-/// - `system_type`, `block_size` (the unknowns' block size of the Krylov path);
+/// - `system_type` (an aeroelastic_system), `block_size` (the unknowns' block size of the Krylov path);
 /// - `system(level, mach)`: the system on that level at that Mach number;
 /// - `level_name(level)`: for labels;
 /// - `equilibrium(s, mu)`: the equilibrium of s at mu from scratch (a steady solve; may throw
-///   convergence_error);
+///   convergence_error); optionally `equilibrium_from(s, w0, mu0, mu)`: the same continued from
+///   w0, the equilibrium at mu0 (used where the equilibrium moves with mu);
 /// - `prolong(fine, coarse, p)`: an eigenvector of `coarse` as one of `fine` (grid sequencing);
 /// - `refines(coarse_level, fine_level)`: whether prolong works between the two levels;
 /// - `structure_part(p)`: the structural unknowns of an eigenvector (the mode test);
 /// - `stiffness_factor(mu)`: q(mu) with A(mu) = A0 + q(mu) B, B in the structural block, and
 ///   its inverse `parameter_of_factor(q)` > 0 (the crossing check; the aerofoil: q = 1/Ubar^2).
 template <class F>
-concept flutter_family = requires(const F& f, const typename F::system_type& s, int level, double mach,
+concept flutter_family = aeroelastic_system<typename F::system_type> &&
+                         requires(const F& f, const typename F::system_type& s, int level, double mach,
                                   const vec<std::complex<double>>& p) {
   { F::block_size } -> std::convertible_to<int>;
   { f.system(level, mach) } -> std::convertible_to<typename F::system_type>;
@@ -194,6 +197,10 @@ struct flutter_boundary_costs {
   double hopf_per_steady_listed = NAN;  ///< all work beyond one steady solve per listed Mach number
   std::size_t continued = 0, listed = 0;
   double work_seconds = 0;  ///< every second of the boundary (Hopf work and steady solves)
+  /// of the continued points: the Hopf work and the steady solves at unlisted Mach numbers ...
+  double beyond_steady_seconds = 0;
+  /// ... and the steady solves at listed ones (the unit of hopf_per_steady_listed)
+  double listed_steady_seconds = 0;
 };
 
 namespace internal {
@@ -250,14 +257,12 @@ inline void check_flutter_boundary_options(const flutter_boundary_options& o, co
 
 }  // namespace internal
 
-/// |p0^H p1| / (|p0| |p1|) of the structural parts: the mode test. The flow part is no test:
-/// shock motion rotates it (full cosine 0.16-0.45 along one NACA 0012 branch).
+/// The mode test: structural_cosine (nonlinear/aeroelastic_system.hpp) of the structural parts
+/// of two eigenvectors. The flow part is no test: shock motion rotates it (full cosine 0.16-0.45
+/// along one NACA 0012 branch).
 template <flutter_family F>
 double structural_cosine(const F& family, const vec<std::complex<double>>& p0, const vec<std::complex<double>>& p1) {
-  const vec<std::complex<double>> s0 = family.structure_part(p0), s1 = family.structure_part(p1);
-  require(s0.size() == s1.size() && s0.size() > 0, "structural_cosine: structural parts of sizes ", s0.size(), " and ",
-          s1.size());
-  return std::abs(s0.dot(s1)) / (s0.norm() * s1.norm());
+  return structural_cosine<std::complex<double>>(family.structure_part(p0), family.structure_part(p1));
 }
 
 namespace internal {
@@ -283,6 +288,7 @@ class flutter_boundary_tracer {
  private:
   struct solved_flow {
     double mach;
+    double mu;  ///< the parameter the equilibrium w was solved at (it moves with mu in moving_equilibrium mode)
     vec<double> w;
     double seconds = 0;
     bool charged = false;  ///< its seconds were added to rejected_ (an attempt there was rejected)
@@ -337,7 +343,7 @@ class flutter_boundary_tracer {
     hopf_options ho = hopf_opts(label, !o_.moving_equilibrium);
     const auto t0 = clk::now();
     try {
-      hopf_result h = o_.moving_equilibrium ? full_hopf(s, g, ho, ko, label) : solve_hopf_krylov<B>(s, g, ho, ko);
+      hopf_result h = o_.moving_equilibrium ? full_hopf(s, g, st.mu, ho, ko, label) : solve_hopf_krylov<B>(s, g, ho, ko);
       if (o_.parameter_even) h.point.mu = std::abs(h.point.mu);
       if (o_.verbose)
         flutter_say(log_, "    %s: setup (assembly + BILU) %.3f s, GMRES %.3f s, residuals %.3f s\n", label.c_str(),
@@ -362,10 +368,11 @@ class flutter_boundary_tracer {
 
   /// The full Hopf system from the continued guess; where that fails, once more from a refined
   /// start: the fixed-equilibrium Hopf point with the flow frozen at the guess (the start
-  /// refinement of the eigenvector, to 1e-4), and the equilibrium at its mu. A continued
+  /// refinement of the eigenvector, to 1e-4), and the equilibrium at its mu continued from the
+  /// guess's (g.w, the equilibrium at mu_w). A continued
   /// eigenvector is far off where shocks move (||F|| 25-36 and a first step through negative
   /// densities, NACA 0012 coarse at alpha_0 = 1 deg, M > 0.66).
-  hopf_result full_hopf(const S& s, hopf_point g, const hopf_options& ho, const hopf_krylov_options& ko,
+  hopf_result full_hopf(const S& s, hopf_point g, double mu_w, const hopf_options& ho, const hopf_krylov_options& ko,
                         const std::string& label) {
     try {
       return solve_hopf_krylov<B>(s, g, ho, ko);
@@ -382,8 +389,17 @@ class flutter_boundary_tracer {
     g.p = h0.point.p;
     g.mu = o_.parameter_even ? std::abs(h0.point.mu) : h0.point.mu;
     g.omega = h0.point.omega;
-    g.w = f_.equilibrium(s, g.mu);
+    g.w = equilibrium_near(s, g.w, mu_w, g.mu);
     return solve_hopf_krylov<B>(s, g, ho, ko);
+  }
+
+  /// The equilibrium at mu from w0, the one at mu0: the family's equilibrium_from where it has
+  /// one (continuation in mu from a nearby state), else its equilibrium from scratch.
+  vec<double> equilibrium_near(const S& s, const vec<double>& w0, double mu0, double mu) const {
+    if constexpr (requires { f_.equilibrium_from(s, w0, mu0, mu); })
+      return f_.equilibrium_from(s, w0, mu0, mu);
+    else
+      return f_.equilibrium(s, mu);
   }
 
   void write(flutter_boundary_point p, double cos, bool jump = false) {
@@ -435,7 +451,7 @@ class flutter_boundary_tracer {
     for (auto& fl : flows_)
       if (std::abs(fl.mach - m) < 1e-12) return fl;
     const auto t0 = clk::now();
-    solved_flow fl{m, {}, 0, false, false};
+    solved_flow fl{m, mu, {}, 0, false, false};
     if (!flutter_listed(machs_, m) && !flows_.empty()) fl.w = warm_flow(s, m, mu);
     if (fl.w.size() == 0) {
       try {
@@ -895,8 +911,7 @@ crossing_check_record check_flutter_crossing(const F& family, int level, const f
   const auto s = family.system(level, p.mach);
   const vec<double>& w0 = p.point.w;
   const double u1 = p.mu, u2 = 0.5 * p.mu;
-  const vec<std::complex<double>> sp_probe = family.structure_part(p.point.p);
-  const int ns = static_cast<int>(sp_probe.size());
+  const int ns = static_cast<int>(s.structure_size());
   const affine_split sp = split_affine(s.jacobian(w0, u1), family.stiffness_factor(u1), s.jacobian(w0, u2),
                                        family.stiffness_factor(u2), ns, o.label + " crossing check");
   axis_crossing_options ao;
@@ -971,7 +986,7 @@ flutter_boundary trace_flutter_boundary(const F& family, int level, const std::v
 /// the inverse-power start) is left out of hopf_per_steady.
 inline flutter_boundary_costs boundary_costs(const flutter_boundary& b, const std::vector<double>& listed) {
   flutter_boundary_costs c;
-  double hopf = 0, st = 0, extra = 0, st_listed = 0;
+  double hopf = 0, st = 0, extra = 0;
   for (std::size_t k = 0; k < b.points.size(); ++k) {
     const auto& q = b.points[k];
     c.work_seconds += q.hopf_seconds + (q.own_steady ? q.steady_seconds : 0.0);
@@ -979,31 +994,24 @@ inline flutter_boundary_costs boundary_costs(const flutter_boundary& b, const st
     hopf += q.hopf_seconds;
     st += q.steady_seconds;
     if (internal::flutter_listed(listed, q.mach)) {
-      st_listed += q.steady_seconds;
+      c.listed_steady_seconds += q.steady_seconds;
       ++c.listed;
     } else if (q.own_steady) {
       extra += q.steady_seconds;  // a steady solve at an intermediate Mach number
     }
   }
   c.continued = b.points.size() > 0 ? b.points.size() - 1 : 0;
+  c.beyond_steady_seconds = hopf + extra;
   if (c.continued > 0) c.hopf_per_steady = hopf / st;
-  if (c.listed > 0) c.hopf_per_steady_listed = (hopf + extra) / st_listed;
+  if (c.listed > 0) c.hopf_per_steady_listed = c.beyond_steady_seconds / c.listed_steady_seconds;
   return c;
 }
 
 /// The same per listed steady solve of `fine`, with the coarser boundary's whole work charged.
 inline double boundary_cost_with_coarser(const flutter_boundary& fine, const flutter_boundary& coarse,
                                          const std::vector<double>& listed) {
-  double hopf = 0, extra = 0, st_listed = 0;
-  for (std::size_t k = 1; k < fine.points.size(); ++k) {
-    const auto& q = fine.points[k];
-    hopf += q.hopf_seconds;
-    if (internal::flutter_listed(listed, q.mach))
-      st_listed += q.steady_seconds;
-    else if (q.own_steady)
-      extra += q.steady_seconds;
-  }
-  return (hopf + extra + boundary_costs(coarse, listed).work_seconds) / st_listed;
+  const flutter_boundary_costs f = boundary_costs(fine, listed);
+  return (f.beyond_steady_seconds + boundary_costs(coarse, listed).work_seconds) / f.listed_steady_seconds;
 }
 
 }  // namespace aerohopf

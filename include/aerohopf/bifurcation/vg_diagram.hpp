@@ -200,13 +200,6 @@ inline void vg_locate_flutter(const std::vector<vg_point>& m, std::vector<vg_flu
   }
 }
 
-/// |a^H b| / (||a|| ||b||), 0 if either is zero.
-inline double normalised_overlap(const vec<std::complex<double>>& a, const vec<std::complex<double>>& b) {
-  const double na = a.norm(), nb = b.norm();
-  if (!(na > 0) || !(nb > 0)) return 0.0;
-  return std::abs(a.dot(b)) / (na * nb);
-}
-
 struct vg_mode_state {
   std::complex<double> lambda;
   vec<std::complex<double>> vector;   // full eigenvector (start of the next inverse power)
@@ -285,7 +278,7 @@ vg_result vg_trace(const S& sys, const Equilibrium& equilibrium, const std::vect
       res.linear_iterations += ep.linear_iterations;
       const double scale = std::max(1.0, std::abs(ep.lambda));
       for (const auto& c : cand)  // the same eigenpair found from another shift
-        if (std::abs(c.ep.lambda - ep.lambda) <= 1e-8 * scale && normalised_overlap(c.ep.vector, ep.vector) > 1 - 1e-6)
+        if (std::abs(c.ep.lambda - ep.lambda) <= 1e-8 * scale && structural_cosine(c.ep.vector, ep.vector) > 1 - 1e-6)
           return;
       vec<C> t = part(ep.vector);
       if (t.norm() < opt.min_tracked_share * ep.vector.norm()) {  // decoupled from the tracked unknowns
@@ -316,7 +309,7 @@ vg_result vg_trace(const S& sys, const Equilibrium& equilibrium, const std::vect
         if (pick[k] >= 0) continue;
         for (std::size_t c = 0; c < cand.size(); ++c) {
           if (used[c]) continue;
-          const double o = normalised_overlap(refs[k], cand[c].tracked);
+          const double o = structural_cosine(refs[k], cand[c].tracked);
           if (o > best) {
             best = o;
             bk = k;

@@ -138,7 +138,10 @@ class aerofoil_system {
     flow::euler_model<2> f = flow_;
     vec<double> wf = f.free_stream_vector();
     const auto report = flow::solve_steady<2>(f, wf, opt);
-    if (!report.converged) throw convergence_error("aerofoil_system::steady_equilibrium: steady solve did not converge");
+    if (!report.converged)
+      throw convergence_error(internal::concat("aerofoil_system::steady_equilibrium: the steady flow at M = ",
+                                               flow_.conditions().mach, " with the section at rest did not converge (",
+                                               report.steps, " steps, residual ", report.final_residual, ": ", report.reason, ")"));
     vec<double> w = free_stream_state();
     w.head(nf_) = wf;
     const auto [cl, cm] = load_coefficients<double>(w);

@@ -8,13 +8,15 @@
 // At a non-zero angle of attack the flow loads the section, so the equilibrium is the static
 // aeroelastic one and moves with Ubar (spec 05, "A moving equilibrium"): static_equilibrium
 // solves it by Newton-Krylov on the coupled system from the steady flow about the section at
-// rest (pseudo-transient, the unit of cost).
+// rest (pseudo-transient, the unit of cost). boundary_options() are the driver's options that
+// suit this family (the tracer's step metric in (Ubar, M, omega), its bounds and tolerances).
 #include <cmath>
 #include <complex>
 #include <string>
 #include <utility>
 
 #include "../bifurcation/equilibrium_krylov.hpp"
+#include "../bifurcation/flutter_boundary.hpp"
 #include "../error.hpp"
 #include "../flow/euler_model.hpp"
 #include "../flow/steady_solver.hpp"
@@ -67,29 +69,26 @@ class aerofoil_family {
   bool fixed_equilibrium() const { return alpha_ == 0.0; }
 
   /// The static aeroelastic equilibrium at Ubar: the steady flow about the section at rest
-  /// (solve_steady from the free stream), then Newton-Krylov on the coupled system
-  /// (solve_equilibrium_krylov, BILU(fill), ||f||_2 <= tolerance) for the deflected section and
-  /// its flow, in FULL Newton steps: from the loaded rest state the first step overshoots the
+  /// (aerofoil_system::steady_equilibrium, loads allowed), then Newton-Krylov on the coupled
+  /// system (solve_equilibrium_krylov, BILU(fill), ||f||_2 <= tolerance) for the deflected section
+  /// and its flow, in FULL Newton steps: from the loaded rest state the first step overshoots the
   /// deflection and raises ||f||, and a halving line search then crawls (NACA 0012 coarse,
   /// alpha_0 = 1 deg, Ubar = 1.66: no convergence in 40 damped iterations; 6 full ones on the
-  /// very coarse grid). A failed solve is continued in Ubar (deflection ~ Ubar^2) from half the
-  /// remaining step, down to 1/64 of Ubar; then convergence_error names the last Ubar reached.
+  /// very coarse grid).
   vec<double> static_equilibrium(const aerofoil_system& s, double ubar, int fill = 2, double tolerance = 1e-10) const {
     require(std::isfinite(ubar) && ubar != 0.0, "aerofoil_family::static_equilibrium: Ubar = ", ubar);
-    flow::euler_model<2> f = s.flow();
-    vec<double> wf = f.free_stream_vector();
-    const auto report = flow::solve_steady<2>(f, wf, steady_);
-    if (!report.converged)
-      throw convergence_error(internal::concat("aerofoil_family::static_equilibrium: the steady flow about the section at "
-                                               "rest did not converge at M = ", s.flow().conditions().mach));
-    vec<double> w = s.free_stream_state();
-    w.head(s.flow_size()) = wf;
-    return static_equilibrium_from(s, std::move(w), 0.0, ubar, fill, tolerance);
+    return static_equilibrium_from(s, s.steady_equilibrium(steady_, INFINITY), 0.0, ubar, fill, tolerance);
   }
 
-  /// The same from the equilibrium w0 at Ubar u0 (0: the section at rest, any Ubar), continued to ubar.
+  /// The same from w0, the static equilibrium at Ubar u0 (0: the section at rest, any Ubar),
+  /// continued to ubar (up or down in |Ubar|; the deflection grows like Ubar^2): a failed solve
+  /// is retried from half the remaining step, down to 1/64 of |Ubar|; then convergence_error
+  /// names the last Ubar reached.
   vec<double> static_equilibrium_from(const aerofoil_system& s, vec<double> w0, double u0, double ubar, int fill = 2,
                                       double tolerance = 1e-10) const {
+    require(std::isfinite(ubar) && ubar != 0.0 && std::isfinite(u0), "aerofoil_family::static_equilibrium_from: Ubar = ",
+            ubar, " from ", u0);
+    require_size(w0.size(), s.size(), "aerofoil_family::static_equilibrium_from", "start state");
     equilibrium_krylov_options eo;
     eo.fill_level = fill;
     eo.newton.abs_tolerance = tolerance;
@@ -97,25 +96,64 @@ class aerofoil_family {
     eo.newton.throw_on_failure = false;
     eo.newton.line_search = false;
     const double a = std::abs(ubar);
-    double u = std::abs(u0), step = a - std::abs(u0);
+    double u = std::abs(u0), step = a - u;  // signed: towards a
     vec<double> w = std::move(w0);
     const std::string who =
         internal::concat("aerofoil_family::static_equilibrium at M = ", s.flow().conditions().mach, ", Ubar = ", ubar);
-    while (u < a) {
-      const double next = std::min(a, u + step);
+    while (u != a) {
+      const double next = std::abs(a - u) <= std::abs(step) ? a : u + step;
       auto r = solve_equilibrium_krylov<block_size>(s, next, w, eo, who);
       if (r.report.converged) {
         w = std::move(r.w);
         u = next;
-        step = std::min(2 * step, a - u);
+        step *= 2;
         continue;
       }
       step *= 0.5;
-      if (step < a / 64)
+      if (std::abs(step) < a / 64)
         throw convergence_error(internal::concat(who, ": Newton-Krylov failed at Ubar = ", next, " from Ubar = ", u,
                                                  " (", r.report.reason, ")"));
     }
     return w;
+  }
+
+  /// The equilibrium at ubar from w0, the one at u0 (flutter_family's optional continuation):
+  /// w0 itself at zero incidence, else static_equilibrium_from.
+  vec<double> equilibrium_from(const aerofoil_system& s, const vec<double>& w0, double u0, double ubar) const {
+    if (alpha_ != 0.0) return static_equilibrium_from(s, w0, u0, ubar);
+    require_size(w0.size(), s.size(), "aerofoil_family::equilibrium_from", "start state");
+    return w0;
+  }
+
+  /// The flutter-boundary driver's options for this family: the tracer's step metric Ubar / 0.5,
+  /// M / 0.01, omega / 0.05 (a step of 1 is at most 0.01 in M), steps 0.5 .. 1 down to 1e-3,
+  /// Ubar in [0.2, 20]; 8 Newton iterations per corrector, abandoned once ||F|| rises after its
+  /// first step (on the heavy medium grid near M = 0.826 every converged corrector was monotone
+  /// from iteration 2 on, the failed ones rose 1.4-2500x: fail fast for the next fallback); the
+  /// nested steady Newton to ||f||_2 <= 1e-10 (1e-11 is the medium grid's rounding floor) and
+  /// dw0/dnu by GMRES to 1e-4 (it only sets a Jacobian column and the warm start); Ubar enters
+  /// as 1/Ubar^2 (parameter_even); the moving-equilibrium mode at non-zero incidence. The start
+  /// guess (start_mu, start_omega) is the case's.
+  flutter_boundary_options boundary_options() const {
+    flutter_boundary_options o;
+    o.parameter_even = true;
+    o.moving_equilibrium = !fixed_equilibrium();
+    hopf_curve_options& c = o.curve;
+    c.mu_scale = 0.5;
+    c.nu_scale = 0.01;
+    c.omega_scale = 0.05;
+    c.max_step = 1.0;
+    c.step = 0.5;
+    c.min_step = 1e-3;
+    c.mu_min = 0.2;
+    c.mu_max = 20.0;
+    c.fast_iterations = 4;
+    c.newton.max_iterations = 8;
+    c.newton.max_contraction = 1.0;
+    c.start.newton.max_iterations = 20;
+    o.fixed_equilibrium.steady.abs_tolerance = 1e-10;
+    o.fixed_equilibrium.derivative_tolerance = 1e-4;
+    return o;
   }
 
   bool refines(int coarse_stride, int fine_stride) const { return coarse_stride == 2 * fine_stride; }

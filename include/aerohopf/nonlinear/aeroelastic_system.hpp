@@ -46,16 +46,22 @@ void check_aeroelastic_layout(const S& s, const std::string& who) {
           " structural entries does not make up the system's ", n, " unknowns");
 }
 
-/// |s_a^H s_b| / (||s_a|| ||s_b||) of the structural parts of two vectors (states or
-/// eigenvectors) of the system: the mode test, 1 for the same structural shape up to a complex
-/// factor. 0 if either structural part is zero.
-template <aeroelastic_system S, class T>
-double structural_overlap(const S& s, const vec<T>& a, const vec<T>& b) {
-  const vec<T> sa = s.structure_part(a), sb = s.structure_part(b);
-  const double na = sa.norm(), nb = sb.norm();
+/// |a^H b| / (||a|| ||b||) of two structural parts: 1 for the same structural shape up to a
+/// complex factor, 0 if either is zero. The one mode test of the library (structural_overlap,
+/// the flutter-boundary driver, the V-g tracking).
+template <class T>
+double structural_cosine(const vec<T>& a, const vec<T>& b) {
+  require(a.size() == b.size(), "structural_cosine: structural parts of sizes ", a.size(), " and ", b.size());
+  const double na = a.norm(), nb = b.norm();
   if (!(na > 0) || !(nb > 0)) return 0.0;
   using std::abs;
-  return abs(sa.dot(sb)) / (na * nb);
+  return abs(a.dot(b)) / (na * nb);
+}
+
+/// structural_cosine of the structural parts of two vectors (states or eigenvectors) of the system.
+template <aeroelastic_system S, class T>
+double structural_overlap(const S& s, const vec<T>& a, const vec<T>& b) {
+  return structural_cosine<T>(s.structure_part(a), s.structure_part(b));
 }
 
 }  // namespace aerohopf
