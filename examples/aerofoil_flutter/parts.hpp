@@ -207,23 +207,9 @@ inline void vg_part(const options& o, const boundaries& all) {
         r = vg_diagram(s, equilibrium, ubars, starts, vo);
       } else {  // GMRES on the exact A - sigma I, BILU(k) of the modified-order L - sigma I
         vo.inverse_power.tolerance = 1e-9;  // inexact inverse iteration: GMRES below it (inverse_power.hpp)
-        double l_mu = NAN;  // the modified-order Jacobian of the last Ubar (the same for every shift there)
-        Eigen::SparseMatrix<double> l;
-        r = vg_diagram(s, equilibrium, ubars, starts, vo, [&](const vec<double>& w, double mu, cplx sigma) {
-          if (!(mu == l_mu)) {
-            l = lhs_jacobian(s, w, mu);
-            l_mu = mu;
-          }
-          krylov_solver_options ko;
-          ko.fill_level = o.fill;
-          ko.krylov.relative_tolerance = 1e-10;
-          ko.krylov.max_iterations = 2000;
-          ko.krylov.restart = 50;  // as the inverse-power start (flutter_boundary_options::start_restart)
-          ko.krylov.record_history = false;
-          krylov_solver<Eigen::SparseMatrix<cplx>, 4> solver(ko, "V-g inverse power, complex BILU-GMRES");
-          solver.precondition_with(shifted(l, sigma));
-          return solver;
-        });
+        vg_krylov_options ko;
+        ko.fill_level = o.fill;
+        r = vg_diagram(s, equilibrium, ubars, starts, vo, vg_krylov_solvers<4>(s, ko));
       }
       const std::string tag = c.name + "_" + g.name + "_M" + fixed(o.vg_mach, 2);
       csv_writer csv(o.out / ("vg_" + tag + ".csv"), "mode,parameter,damping_g,frequency,re,im");

@@ -312,18 +312,14 @@ TEST(vg_diagram, aerofoil_zero_damping_is_the_hopf_point) {
   // every reported eigenpair is one of A (residual test of the inverse power, relative to |lambda|)
   for (const auto& p : r.points) EXPECT_LE(p.residual, 1e-10);
 
-  // the BILU-Krylov route for CFD sizes: a fresh GMRES solver per inverse power, preconditioned
-  // by the complex BILU(1) of the modified-order L - sigma I; the same diagram
-  auto factory = [&](const vec<double>& ws, double mu, cplx sigma) {
-    krylov_solver_options ko;
-    ko.fill_level = 1;
-    ko.krylov.relative_tolerance = 1e-11;
-    ko.krylov.max_iterations = 1000;
-    ko.krylov.restart = 60;
-    krylov_solver<Eigen::SparseMatrix<cplx>, 4> solver(ko, "V-g BILU-GMRES");
-    solver.precondition_with(shifted(s.approximate_jacobian(ws, mu), sigma));
-    return solver;
-  };
+  // the BILU-Krylov route for CFD sizes (vg_krylov_solvers): a fresh GMRES solver per inverse
+  // power, preconditioned by the complex BILU(1) of the modified-order L - sigma I; the same diagram
+  vg_krylov_options ko;
+  ko.fill_level = 1;
+  ko.krylov.relative_tolerance = 1e-11;
+  ko.krylov.max_iterations = 1000;
+  ko.krylov.restart = 60;
+  const auto factory = vg_krylov_solvers<4>(s, ko);
   vg_options ok = o;
   ok.inverse_power.tolerance = 1e-10;
   const vg_result rk = vg_diagram(s, equilibrium, mus, starts, ok, factory);
@@ -333,4 +329,6 @@ TEST(vg_diagram, aerofoil_zero_damping_is_the_hopf_point) {
   ASSERT_EQ(rk.flutter.size(), 1u);
   EXPECT_NEAR(rk.flutter[0].mu, f.mu, 1e-7 * f.mu);
   EXPECT_GT(rk.linear_iterations, 0);
+  ko.fill_level = -1;
+  EXPECT_THROW((void)vg_krylov_solvers<4>(s, ko), input_error);
 }

@@ -55,6 +55,7 @@
 #include <concepts>
 #include <iostream>
 #include <limits>
+#include <memory>
 #include <optional>
 #include <sstream>
 #include <string>
@@ -64,6 +65,8 @@
 #include "../error.hpp"
 #include "../nonlinear/aeroelastic_system.hpp"
 #include "../nonlinear/system.hpp"
+#include "../linalg/direct.hpp"
+#include "../linalg/krylov_solver.hpp"
 #include "inverse_power.hpp"
 
 namespace aerohopf {
@@ -484,6 +487,50 @@ vg_result vg_diagram(const S& sys, const Equilibrium& equilibrium, const std::ve
                                 return inverse_power(a, shift, opt.inverse_power, start, solver);
                               }
                             });
+}
+
+/// Options of vg_krylov_solvers.
+struct vg_krylov_options {
+  int fill_level = 2;  ///< k of the complex BILU(k) of L - sigma I
+  /// GMRES of each shift-invert solve: tighter than vg_options::inverse_power.tolerance (inexact
+  /// inverse iteration with a fixed tolerance stagnates near it, inverse_power.hpp).
+  krylov_options krylov = [] {
+    krylov_options o;
+    o.relative_tolerance = 1e-10;
+    o.max_iterations = 2000;
+    o.restart = 50;  // as the inverse-power start of the boundary driver
+    o.record_history = false;
+    return o;
+  }();
+};
+
+/// The solver factory of vg_diagram for CFD sizes, where a sparse LU of A - sigma I per inverse
+/// power is too dear: each solve (A - sigma I) y = x by complex GMRES on the exact A - sigma I,
+/// right-preconditioned by the complex BILU(k) of L - sigma I, L = lhs_jacobian (the model's
+/// preconditioning Jacobian, e.g. the aerofoil's modified-order one), assembled once per
+/// parameter value (the equilibrium is a function of it) and shifted per inverse power. Use it
+/// with vg_options::inverse_power.tolerance above krylov.relative_tolerance (1e-9 with the
+/// default 1e-10). The factory keeps a reference to sys.
+template <int B, dynamical_system S>
+auto vg_krylov_solvers(const S& sys, const vg_krylov_options& o = {}) {
+  require(o.fill_level >= 0, "vg_krylov_solvers: fill_level must be >= 0 (got ", o.fill_level, ")");
+  validate_krylov_options(o.krylov, "vg_krylov_solvers");
+  struct lhs_cache {
+    double mu = NAN;
+    jacobian_t<S> l;
+  };
+  return [&sys, o, cache = std::make_shared<lhs_cache>()](const vec<double>& w, double mu, std::complex<double> sigma) {
+    if (!(mu == cache->mu)) {
+      cache->l = lhs_jacobian(sys, w, mu);
+      cache->mu = mu;
+    }
+    krylov_solver_options ko;
+    ko.fill_level = o.fill_level;
+    ko.krylov = o.krylov;
+    krylov_solver<Eigen::SparseMatrix<std::complex<double>>, B> solver(ko, "V-g inverse power, complex BILU-GMRES");
+    solver.precondition_with(shifted(cache->l, sigma));
+    return solver;
+  };
 }
 
 }  // namespace aerohopf
