@@ -462,7 +462,7 @@ void expect_point(const strategy_results& r, double mu, double omega, const vec<
 TEST(hopf_strategies, small_systems_every_strategy_every_formulation) {
   using dense = moving_equilibrium_system<Eigen::MatrixXd>;
   using sparse = moving_equilibrium_system<Eigen::SparseMatrix<double>>;
-  for (const Eigen::Vector4d c : {Eigen::Vector4d(moving_c), Eigen::Vector4d(Eigen::Vector4d::Zero())}) {
+  for (const Eigen::Vector4d& c : {Eigen::Vector4d(moving_c), Eigen::Vector4d(Eigen::Vector4d::Zero())}) {
     const dense d(c);
     const sparse sp(c);
     hopf_point g = hopf_start(d, d.equilibrium(0.9), 0.9, 1.9);

@@ -451,6 +451,10 @@ inline void add_hopf_progress(newton_options& nopt, const hopf_options& opt, Eig
     os << (i.relaxation < 1 ? "  (relaxed)" : "") << "\n";
   };
 }
+inline void add_hopf_progress(newton_options& nopt, const hopf_options& opt, Eigen::Index N,
+                              const long& linear_iterations) {
+  add_hopf_progress(nopt, opt, N, &linear_iterations);
+}
 }  // namespace internal
 
 /// A linear strategy of hopf_newton: the Newton correction dx of the problem's formulation at

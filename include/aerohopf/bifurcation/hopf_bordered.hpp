@@ -28,9 +28,7 @@
 #include <cmath>
 #include <limits>
 #include <complex>
-#include <concepts>
 #include <iomanip>
-#include <optional>
 #include <string>
 #include <tuple>
 #include <utility>
