@@ -553,6 +553,38 @@ TEST(hopf_bordered_full, full_formulation_hostile_input) {
   EXPECT_THROW(hopf_start_krylov<2>(sp, sp.equilibrium(0.9), 0.9, 1.9, so), convergence_error);
 }
 
+// The bordered direct strategy in the full formulation on the small moving-equilibrium system
+// (dense complex LU, real LU for the flow update): the known point, as fast as the augmented LU;
+// a NaN residual inside the run names (or returns) the last accepted iterate.
+TEST(hopf_bordered_full, small_moving_equilibrium_bordered_direct) {
+  const dense_sys d(moving_c);
+  const hopf_point g = far_guess(sparse_sys(moving_c));
+  direct_solver<Eigen::MatrixXcd> lu;
+  const hopf_result lu_full = solve_hopf(d, g, full_options());
+  const hopf_result r = solve_hopf_bordered(d, g, full_options(), lu);
+  ASSERT_TRUE(r.report.converged) << r.report.reason;
+  EXPECT_NEAR(r.point.mu, 1.0, 1e-10);
+  EXPECT_NEAR(r.point.omega, 2.0, 1e-10);
+  EXPECT_LT((r.point.w - d.equilibrium(1.0)).norm(), 1e-10);
+  EXPECT_LE(r.report.iterations, lu_full.report.iterations + 1);
+  hopf_options o = full_options();
+  o.label = "injected bordered full";
+  try {
+    solve_hopf_bordered(faulty_system(d, 17), g, o, lu);
+    ADD_FAILURE() << "no exception";
+  } catch (const convergence_error& e) {
+    EXPECT_NE(std::string(e.what()).find("last accepted iterate"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("injected bordered full"), std::string::npos) << e.what();
+  }
+  o.newton.throw_on_failure = false;
+  const hopf_result bad = solve_hopf_bordered(faulty_system(d, 17), g, o, lu);
+  EXPECT_FALSE(bad.report.converged);
+  EXPECT_TRUE(bad.point.w.allFinite() && bad.point.p.allFinite());
+  const hopf_result again = solve_hopf_bordered(d, bad.point, full_options(), lu);
+  EXPECT_TRUE(again.report.converged);
+  EXPECT_NEAR(again.point.mu, 1.0, 1e-10);
+}
+
 // ---- the NACA 0012 pitch-plunge at a mean incidence alpha_0 = 1 deg (very coarse grid, light
 // case, M = 0.5): the steady flow lifts and pitches the section, so the equilibrium (its static
 // pitch and plunge deflection) depends on Ubar and only the full formulation applies ----
