@@ -107,6 +107,43 @@ TEST(hopf_bordered, krylov_newton_matches_and_converges_quadratically) {
   }
 }
 
+// Every linear strategy of hopf_newton in both formulations on the symmetric section (the
+// equilibrium does not move with Ubar, so the full formulation lands on the same point, its flow
+// part on the steady solution): against the fixed-equilibrium sparse-LU reference.
+TEST(hopf_bordered, every_strategy_every_formulation_matches_the_augmented_lu) {
+  const auto& f = fix();
+  const hopf_point& ref = reference().point;
+  for (const bool fixed : {true, false}) {
+    hopf_options o = f.opt;
+    o.fixed_equilibrium = fixed;
+    o.label = fixed ? "fixed" : "full";
+    const hopf_problem<aerofoil_system> prob(f.s, f.start, o, "test");
+    hopf_augmented_lu<aerofoil_system> lu(o);
+    direct_solver<Eigen::SparseMatrix<cplx>> complex_lu;
+    hopf_bordered_direct<aerofoil_system, direct_solver<Eigen::SparseMatrix<cplx>>> direct(o, complex_lu);
+    hopf_krylov_options ko;
+    ko.fill_level = 1;
+    ko.full_system = !fixed;
+    hopf_bordered_krylov<4, aerofoil_system> krylov(o, ko);
+    const hopf_result r[] = {hopf_newton(prob, lu, o), hopf_newton(prob, direct, o), hopf_newton(prob, krylov, o)};
+    const char* names[] = {"augmented LU", "bordered direct", "bordered Krylov"};
+    for (int k = 0; k < 3; ++k) {
+      std::cout << o.label << ", " << names[k] << ": Ubar* " << std::setprecision(12) << r[k].point.mu << " omega* "
+                << r[k].point.omega << ", " << r[k].report.iterations << " Newton, " << r[k].linear_iterations
+                << " linear iterations, " << r[k].setup_seconds + r[k].linear_seconds + r[k].residual_seconds
+                << " s\n";
+      ASSERT_TRUE(r[k].report.converged) << names[k];
+      EXPECT_NEAR(r[k].point.mu, ref.mu, (fixed ? 1e-9 : 1e-8) * ref.mu) << names[k];
+      EXPECT_NEAR(r[k].point.omega, ref.omega, (fixed ? 1e-9 : 1e-8) * ref.omega) << names[k];
+      EXPECT_NEAR(r[k].point.mu, r[0].point.mu, 1e-9 * ref.mu) << names[k];
+      EXPECT_NEAR(r[k].point.omega, r[0].point.omega, 1e-9 * ref.omega) << names[k];
+      EXPECT_LT((r[k].point.w - f.w).norm(), 1e-7 * f.w.norm()) << names[k];
+      EXPECT_LT(eigen_residual(f.s, r[k].point), 1e-9) << names[k];
+      EXPECT_LE(r[k].report.iterations, 7) << names[k];
+    }
+  }
+}
+
 TEST(hopf_bordered, grid_sequencing_start_from_the_coarser_grid) {
   const auto& f = fix();
   const aerofoil_system fine = make(4);
@@ -516,6 +553,38 @@ TEST(hopf_bordered_full, full_formulation_hostile_input) {
   EXPECT_THROW(hopf_start_krylov<2>(sp, sp.equilibrium(0.9), 0.9, 1.9, so), convergence_error);
 }
 
+// The bordered direct strategy in the full formulation on the small moving-equilibrium system
+// (dense complex LU, real LU for the flow update): the known point, as fast as the augmented LU;
+// a NaN residual inside the run names (or returns) the last accepted iterate.
+TEST(hopf_bordered_full, small_moving_equilibrium_bordered_direct) {
+  const dense_sys d(moving_c);
+  const hopf_point g = far_guess(sparse_sys(moving_c));
+  direct_solver<Eigen::MatrixXcd> lu;
+  const hopf_result lu_full = solve_hopf(d, g, full_options());
+  const hopf_result r = solve_hopf_bordered(d, g, full_options(), lu);
+  ASSERT_TRUE(r.report.converged) << r.report.reason;
+  EXPECT_NEAR(r.point.mu, 1.0, 1e-10);
+  EXPECT_NEAR(r.point.omega, 2.0, 1e-10);
+  EXPECT_LT((r.point.w - d.equilibrium(1.0)).norm(), 1e-10);
+  EXPECT_LE(r.report.iterations, lu_full.report.iterations + 1);
+  hopf_options o = full_options();
+  o.label = "injected bordered full";
+  try {
+    solve_hopf_bordered(faulty_system(d, 17), g, o, lu);
+    ADD_FAILURE() << "no exception";
+  } catch (const convergence_error& e) {
+    EXPECT_NE(std::string(e.what()).find("last accepted iterate"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("injected bordered full"), std::string::npos) << e.what();
+  }
+  o.newton.throw_on_failure = false;
+  const hopf_result bad = solve_hopf_bordered(faulty_system(d, 17), g, o, lu);
+  EXPECT_FALSE(bad.report.converged);
+  EXPECT_TRUE(bad.point.w.allFinite() && bad.point.p.allFinite());
+  const hopf_result again = solve_hopf_bordered(d, bad.point, full_options(), lu);
+  EXPECT_TRUE(again.report.converged);
+  EXPECT_NEAR(again.point.mu, 1.0, 1e-10);
+}
+
 // ---- the NACA 0012 pitch-plunge at a mean incidence alpha_0 = 1 deg (very coarse grid, light
 // case, M = 0.5): the steady flow lifts and pitches the section, so the equilibrium (its static
 // pitch and plunge deflection) depends on Ubar and only the full formulation applies ----
@@ -552,6 +621,10 @@ struct incidence_fixture {
     o.label = "full krylov, alpha_0 = 1 deg";
     return solve_hopf_krylov<4>(s, start, o, full_krylov());
   }();
+  hopf_result direct = [this] {
+    direct_solver<Eigen::SparseMatrix<cplx>> lu;
+    return solve_hopf_bordered(s, start, full_options(), lu);
+  }();
 };
 
 const incidence_fixture& incidence() {
@@ -585,6 +658,29 @@ TEST(hopf_bordered_full, incidence_krylov_full_matches_lu_full) {
   // the deflection is real and moves with Ubar (else the fixed-equilibrium system would do)
   EXPECT_GT(std::abs(pitch(f.s, k.w)), 1e-4);
   EXPECT_GT(std::abs(pitch(f.s, k.w) - pitch(f.s, f.w_guess)), 1e-3 * std::abs(pitch(f.s, k.w)));
+}
+
+// The bordered direct strategy in the full formulation (complex sparse LU of A - i omega I, the
+// flow update by real LU solves with A) lands on the same point as the Krylov and the LU solve.
+TEST(hopf_bordered_full, incidence_bordered_direct_full_matches_lu_full_and_krylov_full) {
+  const auto& f = incidence();
+  const hopf_point &d = f.direct.point, &k = f.krylov.point, &l = f.lu.point;
+  for (const auto* r : {&f.lu, &f.direct, &f.krylov})
+    std::cout << "alpha_0 = 1 deg, " << (r == &f.lu ? "augmented LU" : r == &f.direct ? "bordered direct" : "bordered Krylov")
+              << ": Ubar* " << std::setprecision(12) << r->point.mu << " omega* " << r->point.omega << ", "
+              << r->report.iterations << " Newton, " << r->linear_iterations << " linear iterations, "
+              << r->setup_seconds + r->linear_seconds + r->residual_seconds << " s\n";
+  ASSERT_TRUE(f.direct.report.converged);
+  EXPECT_NEAR(d.mu, 1.71058562195, 1e-10);
+  EXPECT_NEAR(d.omega, 0.75640197411, 1e-10);
+  EXPECT_NEAR(d.mu, l.mu, 1e-8 * l.mu);
+  EXPECT_NEAR(d.omega, l.omega, 1e-8 * l.omega);
+  EXPECT_NEAR(d.mu, k.mu, 1e-8 * l.mu);
+  EXPECT_NEAR(d.omega, k.omega, 1e-8 * l.omega);
+  EXPECT_LT((d.w - l.w).norm(), 1e-7 * l.w.norm());
+  EXPECT_LT(eigen_residual(f.s, d), 1e-9);
+  EXPECT_EQ(f.direct.linear_iterations, 0);
+  EXPECT_LE(f.direct.report.iterations, f.lu.report.iterations + 1);
 }
 
 // A static aeroelastic solve at Ubar* from the loaded rest state gives the equilibrium part of

@@ -573,9 +573,8 @@ hopf_point flutter_boundary_tracer<F>::predict(const S& s, double m, const solve
       if (o_.predictor == coarse_predictor::automatic) {
         hopf_point h = guess;
         h.w = st.w;
-        vec<double> y;
-        const fixed_equilibrium_hopf_problem<S> pr(s, h, hopf_opts(label + " predictor"), "predictor", y);
-        const double f_secant = pr.residual(y).norm();
+        const hopf_problem<S> pr(s, h, hopf_opts(label + " predictor"), "predictor");
+        const double f_secant = pr.residual(pr.start()).norm();
         use_increment = !(f_secant <= o_.krylov.start_residual_threshold);
         if (o_.verbose)
           flutter_say(log_, "    %s: predictor ||F|| %.3e with the secant eigenvector: %s\n", label.c_str(), f_secant,

@@ -13,6 +13,12 @@
 // The fixed-equilibrium case (w0 does not depend on mu, e.g. a symmetric aerofoil at
 // zero incidence) drops the first block row and column: unknowns [p_r, p_i, mu, omega].
 //
+// Structure: hopf_problem holds either formulation (unknowns, s, the exact F_A, unpacking and
+// post-checks); hopf_newton is the one Newton driver; the Newton correction comes from a linear
+// strategy: hopf_augmented_lu (here: LU of the real J_A), hopf_bordered_direct and
+// hopf_bordered_krylov (hopf_bordered.hpp: block elimination on A - i omega I, by complex LU or
+// BILU-GMRES). solve_hopf, solve_hopf_bordered and solve_hopf_krylov pick one of each.
+//
 // The right-hand side products A p are evaluated matrix-free with the EXACT residual (one
 // taylor<double,1> pass when the residual is templated); the left-hand-side matrix may be the
 // system's approximate Jacobian (hopf_options::approximate_lhs) at the price of losing
@@ -26,7 +32,7 @@
 //    a sparse LU fills the factors (measured: 29x more non-zeros and 40x the time at 6,146
 //    unknowns), so this is the default for sparse Jacobians.
 //
-// Post-checks (every Hopf solver: solve_hopf, solve_hopf_bordered, solve_hopf_krylov). Newton
+// Post-checks (hopf_problem::result, so every strategy of hopf_newton). Newton
 // stops at ||F_A|| <= r, r = max(abs_tolerance + rel_tolerance ||F_0||, ||F_final||) (the
 // second term covers the rounding-floor criterion of newton.hpp). A converged point is accepted
 // only if
@@ -50,8 +56,10 @@
 #include <Eigen/Core>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <complex>
+#include <concepts>
 #include <iomanip>
 #include <iostream>
 #include <string>
@@ -94,8 +102,8 @@ struct hopf_result {
   vec<double> s;         ///< the normalisation vector used
   newton_report report;  ///< per-iteration residuals of the augmented system
   long linear_iterations = 0;  ///< Krylov iterations over all solves (0 for direct solvers)
-  /// Wall-clock split (solve_hopf_krylov only; 0 elsewhere): matrix assembly and preconditioner
-  /// factorisation, Krylov solves, and residual evaluations.
+  /// Wall-clock split: matrix assembly and factorisation (or preconditioner), linear solves,
+  /// and residual evaluations (with the second-derivative products of the bordered full step).
   double setup_seconds = 0, linear_seconds = 0, residual_seconds = 0;
   bool start_refined = false;  ///< solve_hopf_krylov: the start refinement was kept
 };
@@ -333,52 +341,190 @@ hopf_point hopf_start(const S& sys, const vec<double>& w, double mu, double omeg
   return internal::hopf_point_from(w, mu, inverse_power(sys.jacobian(w, mu), {0.0, omega_guess}, ipo, nullptr, solver));
 }
 
-/// Newton on the augmented system from a guess (w, mu, omega, p of any normalisation).
+/// One Hopf problem in either formulation (file comment), from opt.fixed_equilibrium:
+///  * full (3n + 2 unknowns y = [w, p_r, p_i, mu, omega]): the equilibrium moves with mu;
+///  * fixed equilibrium (2n + 2 unknowns y = [p_r, p_i, mu, omega]): w = guess.w at every mu.
+/// Holds the normalisation vector s, the start y0 (the guess with p normalised) and the exact
+/// residual F_A (matrix-free eigen-equations); result() unpacks a Newton run and applies the
+/// post-checks. Every Hopf solver is hopf_newton over this problem with a linear strategy.
 template <dynamical_system S>
-hopf_result solve_hopf(const S& sys, const hopf_point& guess, const hopf_options& opt = {}) {
-  using M = jacobian_t<S>;
-  const Eigen::Index n = sys.size();
-  internal::check_hopf_guess(sys, guess, "solve_hopf");
-  internal::check_hopf_options(opt, "solve_hopf");
+class hopf_problem {
+ public:
+  /// Checks the guess and opt (input_error naming `who`) and normalises guess.p.
+  hopf_problem(const S& system, const hopf_point& guess, const hopf_options& opt, const std::string& who)
+      : sys_(&system), fixed_(opt.fixed_equilibrium) {
+    internal::check_hopf_guess(system, guess, who);
+    internal::check_hopf_options(opt, who);
+    n_ = system.size();
+    off_ = fixed_ ? 0 : n_;
+    vec<std::complex<double>> p = guess.p;
+    s_ = hopf_normalise(p, resolve_normalisation<jacobian_t<S>>(opt.normalisation));
+    y0_.resize(unknowns());
+    if (fixed_) w_fixed_ = guess.w;
+    else y0_.head(n_) = guess.w;
+    y0_.segment(off_, n_) = p.real();
+    y0_.segment(off_ + n_, n_) = p.imag();
+    y0_[unknowns() - 2] = guess.mu;
+    y0_[unknowns() - 1] = guess.omega;
+  }
 
-  vec<std::complex<double>> p = guess.p;
-  const hopf_normalisation mode = resolve_normalisation<M>(opt.normalisation);
-  const vec<double> s = hopf_normalise(p, mode);
-  const bool sym = opt.fixed_equilibrium;
-  const Eigen::Index off = sym ? 0 : n;  // offset of p_r in the unknown vector
-  const Eigen::Index N = off + 2 * n + 2;
-  vec<double> x(N);
-  if (!sym) x.head(n) = guess.w;
-  x.segment(off, n) = p.real();
-  x.segment(off + n, n) = p.imag();
-  x[N - 2] = guess.mu;
-  x[N - 1] = guess.omega;
-  const vec<double> w_fixed = guess.w;
+  const S& system() const { return *sys_; }
+  bool fixed_equilibrium() const { return fixed_; }
+  Eigen::Index size() const { return n_; }                  ///< n, the system's unknowns
+  Eigen::Index unknowns() const { return off_ + 2 * n_ + 2; }  ///< 3n + 2 or 2n + 2
+  Eigen::Index eigen_offset() const { return off_; }        ///< where p_r starts in y
+  const vec<double>& s() const { return s_; }
+  const vec<double>& start() const { return y0_; }
 
-  auto unpack_w = [&](const vec<double>& y) -> vec<double> { return sym ? w_fixed : vec<double>(y.head(n)); };
+  vec<double> w(const vec<double>& y) const { return fixed_ ? w_fixed_ : vec<double>(y.head(n_)); }
+  vec<double> p_re(const vec<double>& y) const { return y.segment(off_, n_); }
+  vec<double> p_im(const vec<double>& y) const { return y.segment(off_ + n_, n_); }
+  double mu(const vec<double>& y) const { return y[unknowns() - 2]; }
+  double omega(const vec<double>& y) const { return y[unknowns() - 1]; }
+
+  /// F_A(y) (file comment); the fixed-equilibrium formulation drops the first block f(w, mu).
+  vec<double> residual(const vec<double>& y) const {
+    const vec<double> wy = w(y), pr = p_re(y), pi = p_im(y);
+    const double m = mu(y), om = omega(y);
+    vec<double> f(unknowns());
+    if (!fixed_) f.head(n_) = sys_->residual(wy, m);
+    f.segment(off_, n_) = jacobian_product(*sys_, wy, m, pr) + om * pi;
+    f.segment(off_ + n_, n_) = jacobian_product(*sys_, wy, m, pi) - om * pr;
+    f[unknowns() - 2] = s_.dot(pr);
+    f[unknowns() - 1] = s_.dot(pi) - 1.0;
+    return f;
+  }
+
+  /// The point of a Newton run with omega > 0 (a converged conjugate pair is the same point),
+  /// after the post-checks (hopf_accept).
+  hopf_result result(newton_result&& nr, const hopf_options& opt) const {
+    hopf_result res;
+    res.s = s_;
+    res.report = std::move(nr.report);
+    const vec<double>& y = nr.x;
+    res.point.w = w(y);
+    res.point.mu = mu(y);
+    res.point.omega = omega(y);
+    res.point.p = vec<std::complex<double>>(n_);
+    res.point.p.real() = p_re(y);
+    res.point.p.imag() = p_im(y);
+    if (res.report.converged && res.point.omega < 0) {
+      res.point.omega = -res.point.omega;
+      res.point.p = res.point.p.conjugate().eval();
+    }
+    internal::hopf_accept(*sys_, res, opt, fixed_);
+    return res;
+  }
+
+ private:
+  const S* sys_;
+  bool fixed_;
+  Eigen::Index n_ = 0, off_ = 0;
+  vec<double> s_, y0_, w_fixed_;
+};
+
+/// What a linear strategy of hopf_newton counts: Krylov iterations (0 for direct solvers) and
+/// the wall-clock split of hopf_result.
+struct hopf_linear_stats {
+  long linear_iterations = 0;
+  double setup_seconds = 0, linear_seconds = 0, residual_seconds = 0;
+};
+
+namespace internal {
+using hopf_clock = std::chrono::steady_clock;
+inline double seconds_since(hopf_clock::time_point t0) {
+  return std::chrono::duration<double>(hopf_clock::now() - t0).count();
+}
+
+/// Progress line per Newton iteration of a Hopf solve with N unknowns, mu and omega last (with
+/// the running linear-iteration count when `linear_iterations` is given); only with
+/// opt.verbose and no observer of the caller's.
+inline void add_hopf_progress(newton_options& nopt, const hopf_options& opt, Eigen::Index N,
+                              const long* linear_iterations) {
+  if (!opt.verbose || !opt.log || nopt.observer) return;
+  std::ostream& os = *opt.log;
+  nopt.observer = [&os, label = opt.label, N, linear_iterations](const newton_step_info& i) {
+    os << label << " it " << std::setw(2) << i.iteration << "  |F| " << std::scientific << std::setprecision(3)
+       << i.residual << "  mu " << std::setprecision(12) << std::defaultfloat << (*i.x)[N - 2] << "  omega "
+       << (*i.x)[N - 1];
+    if (linear_iterations) os << "  linear its " << *linear_iterations;
+    os << (i.relaxation < 1 ? "  (relaxed)" : "") << "\n";
+  };
+}
+inline void add_hopf_progress(newton_options& nopt, const hopf_options& opt, Eigen::Index N,
+                              const long& linear_iterations) {
+  add_hopf_progress(nopt, opt, N, &linear_iterations);
+}
+}  // namespace internal
+
+/// A linear strategy of hopf_newton: the Newton correction dx of the problem's formulation at
+/// the iterate y with residual f = F_A(y), its counts in `stats`, and the name of the system it
+/// solves (for messages).
+template <class L, class S>
+concept hopf_linear_strategy = requires(L& l, const hopf_problem<S>& prob, const vec<double>& y, int it) {
+  { l.newton_step(prob, y, y, it) } -> std::convertible_to<vec<double>>;
+  { l.description(prob) } -> std::convertible_to<std::string>;
+  { l.stats } -> std::convertible_to<hopf_linear_stats>;
+  { L::reports_linear_iterations } -> std::convertible_to<bool>;
+};
+
+/// The Hopf Newton driver: Newton (newton_iterate: relaxation, tolerances, divergence guards)
+/// on prob's F_A from prob.start(), the corrections from `strategy`, progress lines with
+/// opt.verbose, failures naming the last accepted iterate (run_hopf_newton) and the post-checks
+/// of the converged point (file comment).
+template <dynamical_system S, class Strategy>
+  requires hopf_linear_strategy<Strategy, S>
+hopf_result hopf_newton(const hopf_problem<S>& prob, Strategy& strategy, const hopf_options& opt) {
+  const Eigen::Index N = prob.unknowns();
+  hopf_linear_stats& st = strategy.stats;
   auto residual = [&](const vec<double>& y) {
-    const vec<double> w = unpack_w(y);
-    const double mu = y[N - 2], om = y[N - 1];
-    const vec<double> pr = y.segment(off, n), pi = y.segment(off + n, n);
-    vec<double> f(N);
-    if (!sym) f.head(n) = sys.residual(w, mu);
-    f.segment(off, n) = jacobian_product(sys, w, mu, pr) + om * pi;
-    f.segment(off + n, n) = jacobian_product(sys, w, mu, pi) - om * pr;
-    f[N - 2] = s.dot(pr);
-    f[N - 1] = s.dot(pi) - 1.0;
+    const auto t0 = internal::hopf_clock::now();
+    vec<double> f = prob.residual(y);
+    st.residual_seconds += internal::seconds_since(t0);
     return f;
   };
-  direct_solver<M> lu(opt.label + ": augmented Jacobian");
-  internal::hopf_iterate_log last(x, N - 2, N - 1);
-  auto step = [&](const vec<double>& y, const vec<double>& f, int k) {
-    last.record(y, f, k);
-    const vec<double> w = unpack_w(y);
-    const double mu = y[N - 2], om = y[N - 1];
-    const vec<double> pr = y.segment(off, n), pi = y.segment(off + n, n);
-    const M a = opt.approximate_lhs ? lhs_jacobian(sys, w, mu) : M(sys.jacobian(w, mu));
+  internal::hopf_iterate_log last(prob.start(), N - 2, N - 1);
+  auto step = [&](const vec<double>& y, const vec<double>& f, int it) {
+    last.record(y, f, it);
+    return vec<double>(strategy.newton_step(prob, y, f, it));
+  };
+  newton_options nopt = opt.newton;
+  internal::add_hopf_progress(nopt, opt, N, Strategy::reports_linear_iterations ? &st.linear_iterations : nullptr);
+  const std::string what = opt.label + " (" + strategy.description(prob) + ")";
+  newton_result nr = internal::run_hopf_newton(
+      [&] { return newton_iterate(residual, step, prob.start(), nopt, what); }, last, opt);
+  hopf_result r = prob.result(std::move(nr), opt);
+  r.linear_iterations = st.linear_iterations;
+  r.setup_seconds = st.setup_seconds;
+  r.linear_seconds = st.linear_seconds;
+  r.residual_seconds = st.residual_seconds;
+  return r;
+}
+
+/// Linear strategy (a): the whole real augmented Jacobian J_A (file comment; 3n + 2 or 2n + 2)
+/// assembled at every iterate and solved by LU (sparse or dense as the system's Jacobian).
+/// opt.approximate_lhs puts the system's approximate Jacobian in place of A.
+template <dynamical_system S>
+class hopf_augmented_lu {
+ public:
+  static constexpr bool reports_linear_iterations = false;
+  hopf_linear_stats stats;
+
+  explicit hopf_augmented_lu(const hopf_options& opt)
+      : approximate_lhs_(opt.approximate_lhs), lu_(opt.label + ": augmented Jacobian") {}
+  std::string description(const hopf_problem<S>&) const { return "augmented system"; }
+
+  vec<double> newton_step(const hopf_problem<S>& prob, const vec<double>& y, const vec<double>& f, int) {
+    using M = jacobian_t<S>;
+    const S& sys = prob.system();
+    const Eigen::Index n = prob.size(), N = prob.unknowns(), off = prob.eigen_offset();
+    const vec<double> w = prob.w(y), pr = prob.p_re(y), pi = prob.p_im(y), &s = prob.s();
+    const double mu = prob.mu(y), om = prob.omega(y);
+    auto t0 = internal::hopf_clock::now();
+    const M a = approximate_lhs_ ? lhs_jacobian(sys, w, mu) : M(sys.jacobian(w, mu));
     const M amu = jacobian_d_mu(sys, w, mu);
     block_assembler<M> j(N, N);
-    if (!sym) {
+    if (!prob.fixed_equilibrium()) {
       j.add(0, 0, a);
       j.add_column(0, N - 2, residual_d_mu(sys, w, mu));
       j.add(off, 0, jacobian_directional(sys, w, mu, pr));
@@ -394,38 +540,26 @@ hopf_result solve_hopf(const S& sys, const hopf_point& guess, const hopf_options
     j.add_column(off + n, N - 1, -pr);
     j.add_row(N - 2, off, s);
     j.add_row(N - 1, off + n, s);
-    lu.compute(j.build());
-    return vec<double>(-lu.solve(f));
-  };
-  newton_options nopt = opt.newton;
-  if (opt.verbose && opt.log && !nopt.observer) {
-    std::ostream& os = *opt.log;
-    const std::string label = opt.label;
-    nopt.observer = [&os, label, N](const newton_step_info& i) {
-      os << label << " it " << std::setw(2) << i.iteration << "  |F| " << std::scientific << std::setprecision(3)
-         << i.residual << "  mu " << std::setprecision(12) << std::defaultfloat << (*i.x)[N - 2] << "  omega "
-         << (*i.x)[N - 1] << (i.relaxation < 1 ? "  (relaxed)" : "") << "\n";
-    };
+    lu_.compute(j.build());
+    stats.setup_seconds += internal::seconds_since(t0);
+    t0 = internal::hopf_clock::now();
+    vec<double> dx = -lu_.solve(f);
+    stats.linear_seconds += internal::seconds_since(t0);
+    return dx;
   }
-  newton_result nr = internal::run_hopf_newton(
-      [&] { return newton_iterate(residual, step, x, nopt, opt.label + " (augmented system)"); }, last, opt);
-  hopf_result r;
-  r.s = s;
-  r.report = std::move(nr.report);
-  const vec<double>& y = nr.x;
-  r.point.w = unpack_w(y);
-  r.point.mu = y[N - 2];
-  r.point.omega = y[N - 1];
-  r.point.p = vec<std::complex<double>>(n);
-  r.point.p.real() = y.segment(off, n);
-  r.point.p.imag() = y.segment(off + n, n);
-  if (r.report.converged && r.point.omega < 0) {
-    // The conjugate pair was found: same point, report omega > 0.
-    r.point.omega = -r.point.omega;
-    r.point.p = r.point.p.conjugate().eval();
-  }
-  internal::hopf_accept(sys, r, opt, sym);
-  return r;
+
+ private:
+  bool approximate_lhs_;
+  direct_solver<jacobian_t<S>> lu_;
+};
+
+/// Newton on the augmented system from a guess (w, mu, omega, p of any normalisation), by LU of
+/// the real augmented Jacobian (hopf_augmented_lu); opt.fixed_equilibrium picks the formulation.
+template <dynamical_system S>
+hopf_result solve_hopf(const S& sys, const hopf_point& guess, const hopf_options& opt = {}) {
+  const hopf_problem<S> prob(sys, guess, opt, "solve_hopf");
+  hopf_augmented_lu<S> lu(opt);
+  return hopf_newton(prob, lu, opt);
 }
 
 }  // namespace aerohopf
