@@ -4,6 +4,7 @@
 // TFQMR, BiCGSTAB) with the compute/solve wrapper krylov_solver. See spec 07.
 #include "linalg/block_ilu.hpp"
 #include "linalg/block_sparse_matrix.hpp"
+#include "linalg/bordered_block_matrix.hpp"
 #include "linalg/direct.hpp"
 #include "linalg/krylov.hpp"
 #include "linalg/krylov_solver.hpp"

@@ -326,8 +326,9 @@ class block_sparse_matrix {
   /// y = (A - sigma I) x for a REAL matrix and complex vectors: the product of shifted(A, sigma)
   /// without assembling it (half the matrix bytes per product; the padded unknowns are not
   /// shifted, as in shifted()). x and y of the padded sizes, y must not alias x.
-  void apply_shifted(std::complex<double> sigma, const vec<std::complex<double>>& x,
-                     vec<std::complex<double>>& y) const
+  /// x and y may be segments of longer vectors (a bordered matrix applies its flow part so).
+  void apply_shifted(std::complex<double> sigma, Eigen::Ref<const vec<std::complex<double>>> x,
+                     Eigen::Ref<vec<std::complex<double>>> y) const
     requires std::is_same_v<Scalar, double>
   {
     using C = std::complex<double>;
@@ -637,8 +638,10 @@ class bordered_operator {
     x1_ = x.head(n_);
     apply_operator<S>(*a_, x1_, y1_);
     const auto k = d_.rows();
-    y.head(n_) = y1_ + u_ * x.tail(k);
-    y.tail(k) = vt_ * x1_ + d_ * x.tail(k);
+    y.head(n_) = y1_;
+    y.head(n_).noalias() += u_ * x.tail(k);
+    y.tail(k).noalias() = vt_ * x1_;
+    y.tail(k).noalias() += d_ * x.tail(k);
   }
 
  private:
@@ -648,52 +651,91 @@ class bordered_operator {
   mutable vec<S> x1_, y1_;
 };
 
+namespace internal {
+/// The block elimination of a border of k unknowns around an n x n operator A, given a
+/// preconditioner M of A (the algebra of bordered_preconditioner, which also serves
+/// bordered_block_ilu): W = M^{-1} U (k applications of M, once), S = D - V^T W (k x k, dense LU);
+/// apply() then costs one application of M. M is passed to every call, so the holder of the
+/// elimination may own M and still be moved. apply() allocates nothing.
+template <class S>
+class border_elimination {
+ public:
+  using matrix = Eigen::Matrix<S, Eigen::Dynamic, Eigen::Dynamic>;
+  template <class Pre>
+  void compute(const Pre& m, Eigen::Index n, const matrix& border_columns, const matrix& border_rows,
+               const matrix& corner, std::string_view who) {
+    const auto k = corner.rows();
+    require(corner.cols() == k && border_columns.rows() == n && border_columns.cols() == k && border_rows.rows() == k &&
+                border_rows.cols() == n,
+            who, ": border columns ", border_columns.rows(), "x", border_columns.cols(), ", border rows ",
+            border_rows.rows(), "x", border_rows.cols(), ", corner ", corner.rows(), "x", corner.cols(),
+            " inconsistent with n = ", n);
+    require_operator_size(m, n, who, "inner preconditioner");
+    n_ = n;
+    w_.resize(n, k);
+    r1_.resize(n);
+    z1_.resize(n);
+    for (Eigen::Index c = 0; c < k; ++c) {
+      r1_ = border_columns.col(c);
+      apply_operator<S>(m, r1_, z1_);
+      w_.col(c) = z1_;
+    }
+    const matrix schur = corner - border_rows * w_;
+    vt_ = border_rows;
+    if (!schur.allFinite()) throw singular_matrix_error(internal::concat(who, ": non-finite Schur complement"));
+    schur_.compute(schur);
+    if (k > 0 && !(std::abs(schur_.determinant()) > 0))
+      throw singular_matrix_error(internal::concat(who, ": singular Schur complement of the border"));
+    t_.resize(k);
+    s_.resize(k);
+  }
+  Eigen::Index rows() const { return n_ + w_.cols(); }
+  Eigen::Index border_size() const { return w_.cols(); }
+  /// z = M_bordered^{-1} r (r, z of rows() entries, not aliased).
+  template <class Pre>
+  void apply(const Pre& m, const vec<S>& r, vec<S>& z) const {
+    const auto k = w_.cols();
+    r1_ = r.head(n_);
+    apply_operator<S>(m, r1_, z1_);
+    t_ = r.tail(k);
+    t_.noalias() -= vt_ * z1_;
+    s_ = schur_.solve(t_);
+    z.head(n_) = z1_;
+    z.head(n_).noalias() -= w_ * s_;
+    z.tail(k) = s_;
+  }
+
+ private:
+  Eigen::Index n_ = 0;
+  matrix w_, vt_;
+  Eigen::PartialPivLU<matrix> schur_;
+  mutable vec<S> r1_, z1_, t_, s_;
+};
+}  // namespace internal
+
 /// Preconditioner for a bordered operator by block elimination with a preconditioner M of A:
 /// W = M^{-1} U (k applications, once), Schur complement S = D - V^T W (k x k, dense LU); then
 /// each apply costs ONE application of M^{-1}: x' = M^{-1} r1, s = S^{-1}(r2 - V^T x'),
-/// x = x' - W s. Exact when M^{-1} = A^{-1}.
+/// x = x' - W s. Exact when M^{-1} = A^{-1}. Keeps a pointer to M (which must outlive it).
 template <class Pre, class S>
 class bordered_preconditioner {
  public:
   template <class Op>
-  bordered_preconditioner(const bordered_operator<Op, S>& a, const Pre& m) : m_(&m), n_(a.rows() - a.border_size()) {
-    require_operator_size(m, n_, "bordered_preconditioner", "inner preconditioner");
-    const auto k = a.border_size();
-    w_.resize(n_, k);
-    vec<S> col(n_), z(n_);
-    for (Eigen::Index c = 0; c < k; ++c) {
-      col = a.border_columns().col(c);
-      apply_operator<S>(m, col, z);
-      w_.col(c) = z;
-    }
-    const Eigen::Matrix<S, Eigen::Dynamic, Eigen::Dynamic> schur = a.corner() - a.border_rows() * w_;
-    vt_ = a.border_rows();
-    if (!schur.allFinite()) throw singular_matrix_error("bordered_preconditioner: non-finite Schur complement");
-    schur_.compute(schur);
-    if (k > 0 && !(std::abs(schur_.determinant()) > 0))
-      throw singular_matrix_error("bordered_preconditioner: singular Schur complement of the border");
-    r1_.resize(n_);
-    z1_.resize(n_);
+  bordered_preconditioner(const bordered_operator<Op, S>& a, const Pre& m) : m_(&m) {
+    e_.compute(m, a.rows() - a.border_size(), a.border_columns(), a.border_rows(), a.corner(),
+               "bordered_preconditioner");
   }
-  Eigen::Index rows() const { return n_ + w_.cols(); }
+  Eigen::Index rows() const { return e_.rows(); }
   /// z = M_bordered^{-1} r; r and z of rows() entries (checked once per call).
   void apply(const vec<S>& r, vec<S>& z) const {
     require(r.size() == rows() && z.size() == rows(), "bordered_preconditioner::apply: vector sizes ", r.size(), ", ",
             z.size(), ", expected ", rows());
-    const auto k = w_.cols();
-    r1_ = r.head(n_);
-    apply_operator<S>(*m_, r1_, z1_);
-    const vec<S> s = schur_.solve(r.tail(k) - vt_ * z1_);
-    z.head(n_) = z1_ - w_ * s;
-    z.tail(k) = s;
+    e_.apply(*m_, r, z);
   }
 
  private:
   const Pre* m_;
-  Eigen::Index n_;
-  Eigen::Matrix<S, Eigen::Dynamic, Eigen::Dynamic> w_, vt_;
-  Eigen::PartialPivLU<Eigen::Matrix<S, Eigen::Dynamic, Eigen::Dynamic>> schur_;
-  mutable vec<S> r1_, z1_;
+  internal::border_elimination<S> e_;
 };
 
 }  // namespace aerohopf
