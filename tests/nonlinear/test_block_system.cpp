@@ -16,6 +16,7 @@
 #include <random>
 #include <utility>
 
+#include "support/bordered_test_system.hpp"
 #include "support/error_messages.hpp"
 
 using namespace aerohopf;
@@ -196,4 +197,103 @@ TEST(block_system, checked_jacobians_compares_the_pair_with_the_system_size) {
     EXPECT_TRUE(contains(msg, "small system: exact block Jacobian is 3x3 (padded 4x4)")) << msg;
     EXPECT_TRUE(contains(msg, "system has 5 unknowns (padded 6)")) << msg;
   }
+}
+
+// ---- the bordered form (bordered_system, krylov_jacobians): every interface of a system gives
+// the Krylov path the same bordered matrices ----
+namespace {
+using test_support::modal_block_system;
+using test_support::sparse_view;
+static_assert(bordered_system<modal_block_system> && !block_system<modal_block_system>);
+static_assert(block_system_of<modal_block_system, 5> && !block_system_of<modal_block_system, 4>);
+static_assert((require_block_size<5, modal_block_system>(), true));
+static_assert(bordered_system<aerofoil_system> && block_system<aerofoil_system>);
+static_assert(has_exact_bordered_jacobian<aerofoil_system> && !has_exact_bordered_jacobian<modal_block_system>);
+static_assert(!bordered_system<sparse_view<modal_block_system>> && aeroelastic_system<sparse_view<modal_block_system>>);
+
+void expect_same(const bordered_block_matrix<double, 4>& a, const bordered_block_matrix<double, 4>& b, const char* what) {
+  EXPECT_EQ(a.structure_size(), b.structure_size()) << what;
+  EXPECT_EQ(a.flow().row_ptr(), b.flow().row_ptr()) << what;
+  EXPECT_EQ(a.flow().col_index(), b.flow().col_index()) << what;
+  EXPECT_EQ(a.flow().values(), b.flow().values()) << what;
+  EXPECT_EQ(a.flow_structure(), b.flow_structure()) << what;
+  EXPECT_EQ(a.structure_flow(), b.structure_flow()) << what;
+  EXPECT_EQ(a.structure(), b.structure()) << what;
+}
+}  // namespace
+
+// The aerofoil's own bordered form (flow blocks + 4-wide structural border) is its padded pair
+// split at the structure, bit for bit; krylov_jacobians takes the bordered one, and the same
+// model seen only through its Eigen sparse Jacobians gives the same matrices.
+TEST(block_system, aerofoil_bordered_form_is_its_padded_pair_split_at_the_structure) {
+  const auto s = very_coarse_aerofoil(0.8);
+  const vec<double> w = perturbed_state(s);
+  const double mu = 2.5;
+  const auto b = s.bordered_jacobians(w, mu);
+  const auto p = s.jacobians(w, mu);
+  EXPECT_EQ(b.exact.structure_size(), 4);
+  EXPECT_EQ(b.exact.flow_size(), s.flow_size());
+  expect_same(b.exact, bordered_from_padded(p.exact, 4), "exact");
+  expect_same(b.preconditioning, bordered_from_padded(p.preconditioning, 4), "preconditioning");
+  expect_same(s.bordered_jacobian(w, mu), b.exact, "bordered_jacobian");
+  expect_same(krylov_exact_jacobian<4>(s, w, mu, "test"), b.exact, "krylov_exact_jacobian");
+  const auto k = krylov_jacobians<4>(s, w, mu, "test");
+  expect_same(k.exact, b.exact, "krylov_jacobians");
+  EXPECT_EQ(krylov_border_size<4>(s), 4);
+  struct sparse_only {  // not aeroelastic: the last block (1..B unknowns) is the border
+    const aerofoil_system& a;
+    using jacobian_type = Eigen::SparseMatrix<double>;
+    Eigen::Index size() const { return a.size(); }
+    vec<double> residual(const vec<double>& v, double m) const { return a.residual<double>(v, m); }
+    jacobian_type jacobian(const vec<double>& v, double m) const { return a.jacobian(v, m); }
+    jacobian_type approximate_jacobian(const vec<double>& v, double m) const { return a.approximate_jacobian(v, m); }
+  };
+  const sparse_only so{s};
+  EXPECT_EQ(krylov_border_size<4>(so), 4);
+  const auto ks = krylov_jacobians<4>(so, w, mu, "test");
+  expect_same(ks.exact, b.exact, "sparse route, exact");
+  expect_same(ks.preconditioning, b.preconditioning, "sparse route, preconditioning");
+}
+
+// A structure of 6 unknowns with flow blocks of 5: the model's bordered pair passes through
+// (checked), its sparse view is split at its aeroelastic layout to the same matrices; a padded
+// block_system and a plain sparse system are split at their last block.
+TEST(block_system, krylov_jacobians_view_every_form_as_bordered) {
+  const modal_block_system m(7);
+  vec<double> w = vec<double>::Constant(m.size(), 1.1);
+  w.tail(6) << 0.1, -0.2, 0.3, 0.05, 0.0, -0.1;
+  const auto p = krylov_jacobians<5>(m, w, 0.4, "modal");
+  EXPECT_EQ(p.exact.structure_size(), 6);
+  EXPECT_EQ(p.exact.flow_size(), 35);
+  EXPECT_EQ((Eigen::MatrixXd(p.exact.to_sparse()) - Eigen::MatrixXd(m.jacobian(w, 0.4))).norm(), 0.0);
+  const sparse_view<modal_block_system> v{m};
+  EXPECT_EQ(krylov_border_size<5>(v), 6);
+  const auto pv = krylov_jacobians<5>(v, w, 0.4, "view");
+  EXPECT_EQ((pv.exact.to_dense() - p.exact.to_dense()).norm(), 0.0);
+  EXPECT_EQ((pv.preconditioning.to_dense() - p.preconditioning.to_dense()).norm(), 0.0);
+  EXPECT_EQ(krylov_exact_jacobian<5>(v, w, 0.4, "view").structure_size(), 6);
+  // padded block_system: n = 5 in blocks of 2, the last unknown is the border
+  const small_block_system sb;
+  EXPECT_EQ(krylov_border_size<2>(sb), 1);
+  const vec<double> ws = vec<double>::Ones(5);
+  const auto ps = krylov_jacobians<2>(sb, ws, 2.0, "small");
+  EXPECT_EQ(ps.exact.structure_size(), 1);
+  EXPECT_EQ((Eigen::MatrixXd(ps.exact.to_sparse()) - Eigen::MatrixXd(sb.jacobian(ws, 2.0))).norm(), 0.0);
+  EXPECT_EQ(krylov_exact_jacobian<2>(sb, ws, 2.0, "small").to_dense(), ps.exact.to_dense());
+  // a plain sparse system whose size is a multiple of B: the last whole block
+  const tubular_reactor reactor(10);
+  EXPECT_EQ(krylov_border_size<2>(reactor), reactor.size() % 2 == 0 ? 2 : 1);
+}
+
+// A bordered pair of the wrong size is refused with both sizes.
+TEST(block_system, krylov_jacobians_refuse_a_bordered_pair_of_another_size) {
+  struct short_pair : modal_block_system {
+    using modal_block_system::modal_block_system;
+    Eigen::Index size() const { return modal_block_system::size() + 1; }
+  };
+  const short_pair s(4);
+  const std::string msg =
+      input_error_of([&] { (void)krylov_jacobians<5>(s, vec<double>::Ones(s.size() - 1), 0.5, "short model"); });
+  EXPECT_TRUE(contains(msg, "short model: exact bordered Jacobian is 26x26 (20 flow + 6 structural unknowns), system has 27"))
+      << msg;
 }

@@ -22,9 +22,11 @@
 //          structural unknown; exact, includes the dependence of the loads on the moved geometry),
 //   A_sf: derivative of the wall-pressure integrals by a local jet per wall cell.
 // d_mu and jacobian_d_mu are analytic: -M^{-1} dK/dUbar w_s and the 4x4 block -M^{-1} dK/dUbar.
-// Concepts met: block_system (block_size 4: jacobians() gives the exact and the modified-order
-// matrices in 4 x 4 blocks, the structural unknowns the last block) and aeroelastic_system
-// (flow part first, the 4 structural unknowns last). The Mach number (free stream) is set in
+// Concepts met: bordered_system (block_size 4: bordered_jacobians() gives the exact and the
+// modified-order matrices as 4 x 4 flow blocks + the dense border of the 4 structural unknowns,
+// the form the Krylov path works in), block_system (jacobians(): the same matrices with the
+// structure padded into the last 4 x 4 block, for the callers that take one block matrix) and
+// aeroelastic_system (flow part first, the 4 structural unknowns last). The Mach number (free stream) is set in
 // place by set_mach / set_free_stream: the grid, metrics, halos and wall faces are kept.
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
@@ -42,6 +44,7 @@
 #include "../flow/metrics.hpp"
 #include "../flow/steady_solver.hpp"
 #include "../linalg/block_sparse_matrix.hpp"
+#include "../linalg/bordered_block_matrix.hpp"
 #include "../linalg/direct.hpp"
 #include "../nonlinear/aeroelastic_system.hpp"
 #include "../nonlinear/block_system.hpp"
@@ -209,18 +212,28 @@ class aerofoil_system {
   }
 
   jacobian_type jacobian(const vec<double>& w, double mu) const { return assemble(w, mu, flow::jacobian_kind::exact); }
-  /// block_system: the exact Jacobian and the modified-order one (the preconditioning matrix) in
-  /// 4 x 4 blocks (the structural unknowns are the last block row and column; no padding), what
-  /// the Krylov path takes directly, saving the Eigen round trip (triplets, sort, re-blocking:
-  /// about half the assembly time). The coupling blocks (A_fs, A_ss, A_sf) are the same in the
-  /// two and are computed once (one jet<double, 4> pass of the whole residual: about a seventh
-  /// of the assembly time on the medium grid, measured).
-  block_jacobian_pair<block_size> jacobians(const vec<double>& w, double mu) const {
+  /// bordered_system: the exact Jacobian and the modified-order one (the preconditioning matrix)
+  /// as flow blocks + the dense structural border, what the Krylov path takes directly. The
+  /// coupling blocks (A_fs, A_ss, A_sf) are the same in the two and are computed once (one
+  /// jet<double, 4> pass of the whole residual: about a seventh of the assembly time on the
+  /// medium grid, measured).
+  bordered_jacobian_pair<block_size> bordered_jacobians(const vec<double>& w, double mu) const {
     constexpr const char* who = "aerofoil_system::jacobians";
-    block_jacobian_pair<block_size> p{assemble_blocks(w, mu, flow::jacobian_kind::exact, nullptr, who),
-                                      block_sparse_matrix<double, nv>()};
-    p.preconditioning = assemble_blocks(w, mu, flow::jacobian_kind::modified_order, &p.exact, who);
+    bordered_jacobian_pair<block_size> p;
+    p.exact = assemble_bordered(w, mu, flow::jacobian_kind::exact, nullptr, who);
+    p.preconditioning = assemble_bordered(w, mu, flow::jacobian_kind::modified_order, &p.exact, who);
     return p;
+  }
+  /// The exact Jacobian alone in the bordered form (bordered_jacobians().exact).
+  bordered_block_matrix<double, nv> bordered_jacobian(const vec<double>& w, double mu) const {
+    return assemble_bordered(w, mu, flow::jacobian_kind::exact);
+  }
+  /// block_system: the matrices of bordered_jacobians() in 4 x 4 blocks, the structural unknowns
+  /// the last block row and column (no padding), saving callers that take one block matrix the
+  /// Eigen round trip (triplets, sort, re-blocking: about half the assembly time).
+  block_jacobian_pair<block_size> jacobians(const vec<double>& w, double mu) const {
+    auto p = bordered_jacobians(w, mu);
+    return {padded_form(p.exact), padded_form(p.preconditioning)};
   }
   /// The exact Jacobian alone in blocks (jacobians().exact, without the modified-order one).
   block_sparse_matrix<double, nv> block_jacobian(const vec<double>& w, double mu) const {
@@ -329,18 +342,19 @@ class aerofoil_system {
   jacobian_type assemble(const vec<double>& w, double mu, flow::jacobian_kind kind) const {
     return assemble_blocks(w, mu, kind).to_sparse();
   }
+  block_sparse_matrix<double, nv> assemble_blocks(const vec<double>& w, double mu, flow::jacobian_kind kind) const {
+    return padded_form(assemble_bordered(w, mu, kind));
+  }
 
-  /// The coupled Jacobian in blocks of nv: block rows/columns 0..nc-1 the flow cells, block nc
-  /// the 4 structural unknowns. Pattern: the flow block's, plus the structural column in every
-  /// row (the rigid motion moves every cell) and, in the structural row, the wall cells.
-  /// With coupling_from (a matrix assembled by this function at the same (w, mu)), the coupling
-  /// blocks are copied from it instead of computed.
-  block_sparse_matrix<double, nv> assemble_blocks(const vec<double>& w, double mu, flow::jacobian_kind kind,
-                                                  const block_sparse_matrix<double, nv>* coupling_from = nullptr,
-                                                  const char* who = nullptr) const {
-    check_state(*this, w, mu, who ? who : who_of(kind));
-    using sidx = block_sparse_matrix<double, nv>::storage_index;
-    // A_ff on the moved grid.
+  /// The coupled Jacobian as flow blocks A_ff (the cells, flow::assemble_jacobian on the grid
+  /// moved to w_s) and the structural border: A_fs and A_ss exact from one jet pass, A_sf from
+  /// the wall cells (the loads depend on no other flow unknowns). With coupling_from (a matrix
+  /// assembled by this function at the same (w, mu)), the border is copied from it.
+  bordered_block_matrix<double, nv> assemble_bordered(const vec<double>& w, double mu, flow::jacobian_kind kind,
+                                                      const bordered_block_matrix<double, nv>* coupling_from = nullptr,
+                                                      const char* who = nullptr) const {
+    const char* name = who ? who : who_of(kind);
+    check_state(*this, w, mu, name);
     const vec<double> wf = w.head(nf_);
     block_sparse_matrix<double, nv> aff;
     if (w.tail(4).isZero(0.0)) {
@@ -352,6 +366,58 @@ class aerofoil_system {
       moved.set_grid_motion(pts, &spd);
       flow::assemble_jacobian<2>(moved, wf, kind, aff);
     }
+    if (coupling_from) {
+      require(coupling_from->flow_size() == nf_ && coupling_from->structure_size() == n_structure,
+              "aerofoil_system: coupling blocks from a matrix of another size");
+      return {std::move(aff), coupling_from->flow_structure(), coupling_from->structure_flow(),
+              coupling_from->structure(), name};
+    }
+    // [A_fs; A_ss]: one pass of the coupled residual with a 4-direction jet (direction j =
+    // structural unknown j) gives all 4 columns exactly: the values (moved grid, metrics, Osher
+    // fluxes) are computed once, not once per column.
+    using sjet = jet<double, n_structure>;
+    vec<sjet> wj = w.cast<sjet>();
+    for (int j = 0; j < n_structure; ++j) wj[nf_ + j] = sjet::variable(w[nf_ + j], j);
+    const vec<sjet> rj = residual<sjet>(wj, sjet(mu));
+    Eigen::MatrixXd fs(nf_, n_structure), ss(n_structure, n_structure);
+    Eigen::MatrixXd sf = Eigen::MatrixXd::Zero(n_structure, nf_);
+    for (Eigen::Index i = 0; i < nf_ + n_structure; ++i)
+      for (int j = 0; j < n_structure; ++j) {
+        if (i < nf_) fs(i, j) = rj[i].derivative(j);
+        else ss(i - nf_, j) = rj[i].derivative(j);
+      }
+    // A_sf: loads are linear in the wall pressures; dp/dw of the wall cells by a local jet
+    // in the cell's nv unknowns.
+    using cjet = jet<double, nv>;
+    flow::multiblock_points<double, 2> pts;
+    const auto m = moved_metrics<double>(w, &pts);
+    const auto& minv = structure_.mass_inverse();
+    const double pi = std::numbers::pi, mus = structure_.parameters().mu_s;
+    const double kl = 2.0 / (pi * mus), km = 4.0 / (pi * mus);
+    for (const auto& f : walls_) {
+      const auto [l, c] = face_load_per_pressure<double>(m, pts, f, w[nf_]);
+      for (int which = 0; which < 2; ++which) {
+        const Eigen::Index cell = which == 0 ? f.cell0 : f.cell1;
+        const double weight = which == 0 ? 1.5 : -0.5;
+        std::array<cjet, nv> wc;
+        for (int u = 0; u < nv; ++u) wc[u] = cjet::variable(w[cell * nv + u], u);
+        const cjet p = pressure_of<cjet>(wc.data());
+        for (int v = 0; v < nv; ++v) {
+          const double dp = weight * p.derivative(v);
+          for (int i = 0; i < 4; ++i) sf(i, cell * nv + v) += (minv(i, 1) * kl * l + minv(i, 3) * km * c) * dp;
+        }
+      }
+    }
+    return {std::move(aff), std::move(fs), std::move(sf), std::move(ss), name};
+  }
+
+  /// The bordered Jacobian in blocks of nv: block rows/columns 0..nc-1 the flow cells, block nc
+  /// the 4 structural unknowns. Pattern: the flow part's, plus the structural column in every
+  /// row (the rigid motion moves every cell) and, in the structural row, the wall cells (the
+  /// only flow unknowns the loads depend on) and the diagonal.
+  block_sparse_matrix<double, nv> padded_form(const bordered_block_matrix<double, nv>& j) const {
+    using sidx = block_sparse_matrix<double, nv>::storage_index;
+    const auto& aff = j.flow();
     const auto nc = static_cast<sidx>(nf_ / nv);
     std::vector<sidx> wall_cells;
     for (const auto& f : walls_) {
@@ -375,55 +441,14 @@ class aerofoil_system {
     rp[nc + 1] = static_cast<sidx>(ci.size());
     block_sparse_matrix<double, nv> a;
     a.set_pattern_csr(nc + 1, nc + 1, rp, ci);
-    a.set_zero(false);
     constexpr std::ptrdiff_t bb = nv * nv;
-    for (sidx i = 0; i < nc; ++i)
+    for (sidx i = 0; i < nc; ++i) {
       std::copy(aff.values().begin() + frp[i] * bb, aff.values().begin() + frp[i + 1] * bb, a.values().begin() + rp[i] * bb);
-    if (coupling_from) {
-      const auto& o = *coupling_from;
-      require(o.block_rows() == nc + 1 && o.row_ptr()[nc + 1] - o.row_ptr()[nc] == rp[nc + 1] - rp[nc],
-              "aerofoil_system: coupling blocks from a matrix of another pattern");
-      for (sidx i = 0; i < nc; ++i) a.block_at(rp[i + 1] - 1) = o.block_at(o.row_ptr()[i + 1] - 1);
-      std::copy(o.values().begin() + o.row_ptr()[nc] * bb, o.values().end(), a.values().begin() + rp[nc] * bb);
-      return a;
+      a.block_at(rp[i + 1] - 1) = j.flow_structure().middleRows(Eigen::Index(i) * nv, nv);
     }
-    // [A_fs; A_ss]: the last block of every row. One pass of the coupled residual with a
-    // 4-direction jet (direction j = structural unknown j) gives all 4 columns exactly: the
-    // values (moved grid, metrics, Osher fluxes) are computed once, not once per column.
-    using sjet = jet<double, n_structure>;
-    vec<sjet> wj = w.cast<sjet>();
-    for (int j = 0; j < n_structure; ++j) wj[nf_ + j] = sjet::variable(w[nf_ + j], j);
-    const vec<sjet> rj = residual<sjet>(wj, sjet(mu));
-    for (sidx i = 0; i <= nc; ++i) {
-      auto blk = a.block_at(rp[i + 1] - 1);
-      for (int u = 0; u < nv; ++u) {
-        const sjet& r = rj[Eigen::Index(i) * nv + u];
-        for (int j = 0; j < n_structure; ++j) blk(u, j) = r.derivative(j);
-      }
-    }
-    // A_sf: loads are linear in the wall pressures; dp/dw of the wall cells by a local jet
-    // in the cell's nv unknowns.
-    using cjet = jet<double, nv>;
-    flow::multiblock_points<double, 2> pts;
-    const auto m = moved_metrics<double>(w, &pts);
-    const auto& minv = structure_.mass_inverse();
-    const double pi = std::numbers::pi, mus = structure_.parameters().mu_s;
-    const double kl = 2.0 / (pi * mus), km = 4.0 / (pi * mus);
-    for (const auto& f : walls_) {
-      const auto [l, c] = face_load_per_pressure<double>(m, pts, f, w[nf_]);
-      for (int which = 0; which < 2; ++which) {
-        const Eigen::Index cell = which == 0 ? f.cell0 : f.cell1;
-        const double weight = which == 0 ? 1.5 : -0.5;
-        auto blk = a.block(nc, cell);
-        std::array<cjet, nv> wc;
-        for (int u = 0; u < nv; ++u) wc[u] = cjet::variable(w[cell * nv + u], u);
-        const cjet p = pressure_of<cjet>(wc.data());
-        for (int v = 0; v < nv; ++v) {
-          const double dp = weight * p.derivative(v);
-          for (int i = 0; i < 4; ++i) blk(i, v) += (minv(i, 1) * kl * l + minv(i, 3) * km * c) * dp;
-        }
-      }
-    }
+    for (std::size_t k = 0; k < wall_cells.size(); ++k)
+      a.block_at(rp[nc] + static_cast<sidx>(k)) = j.structure_flow().middleCols(Eigen::Index(wall_cells[k]) * nv, nv);
+    a.block_at(rp[nc + 1] - 1) = j.structure();
     return a;
   }
 

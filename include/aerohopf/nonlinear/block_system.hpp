@@ -16,6 +16,23 @@
 //       //                  modified-order CFD Jacobian; the exact one again if there is none)
 //       // both padded to a multiple of B rows, logical size size() (block_sparse_matrix.hpp).
 //
+// A model whose structure is not one block (a modal wing: 5 x 5 flow blocks, 2m structural
+// unknowns) declares the BORDERED form instead (bordered_system), or besides (the aerofoil):
+//   static constexpr int block_size;                               // B > 0
+//   bordered_jacobian_pair<block_size> bordered_jacobians(const vec<double>& w, double mu) const;
+//       // flow part in blocks of B (whole cells, no padding) + dense border of the structural
+//       // unknowns, any number of them (linalg/bordered_block_matrix.hpp); both of size()
+//   bordered_block_matrix<double, block_size> bordered_jacobian(w, mu) const;   // optional: exact alone
+//
+// The Krylov algorithms take every system through ONE form, the bordered one: krylov_jacobians<B>
+// and krylov_exact_jacobian<B> return the model's bordered matrices, or view the others as
+// bordered: a padded block_system's matrices and a plain dynamical_system's Eigen sparse ones
+// are split into whole blocks of B and a border of the last krylov_border_size<B>(sys) unknowns
+// (the structure of an aeroelastic_system plus what of its flow part does not fill a block;
+// otherwise the last 1..B unknowns, where the padded convention keeps what is not a flow cell).
+// So a system reaches the same matrices through any of its interfaces, and the border is
+// eliminated exactly around the BILU of the flow part (bordered_block_ilu).
+//
 // The block size is part of the type: an algorithm written for blocks of B states it with
 // block_system_of<S, B> (a constraint) or require_block_size<B, S>() (a static_assert with a
 // message), so a model of another block size is a compile-time error, never a silent
@@ -25,9 +42,12 @@
 #include <concepts>
 #include <string>
 #include <type_traits>
+#include <utility>
 
 #include "../error.hpp"
 #include "../linalg/block_sparse_matrix.hpp"
+#include "../linalg/bordered_block_matrix.hpp"
+#include "aeroelastic_system.hpp"
 #include "system.hpp"
 
 namespace aerohopf {
@@ -54,23 +74,47 @@ concept block_system = dynamical_system<S> && internal::declares_block_size<S> &
                          { s.jacobians(w, mu) } -> std::same_as<block_jacobian_pair<S::block_size>>;
                        };
 
-/// A block_system whose block size is B: the constraint of an algorithm written for blocks of B.
-template <class S, int B>
-concept block_system_of = block_system<S> && (S::block_size == B);
+/// The exact Jacobian and the preconditioning matrix in the bordered form, at one (w, mu).
+template <int B>
+struct bordered_jacobian_pair {
+  static_assert(B > 0, "bordered_jacobian_pair: the block size must be a positive compile-time constant");
+  bordered_block_matrix<double, B> exact;
+  bordered_block_matrix<double, B> preconditioning;
+};
 
-template <block_system S>
+/// A model that assembles its Jacobians as flow blocks + a dense structural border (file comment).
+template <class S>
+concept bordered_system = dynamical_system<S> && internal::declares_block_size<S> &&
+                          requires(const S& s, const vec<double>& w, double mu) {
+                            { s.bordered_jacobians(w, mu) } -> std::same_as<bordered_jacobian_pair<S::block_size>>;
+                          };
+
+/// Optional member of a bordered_system: bordered_jacobian(w, mu), the exact matrix alone.
+template <class S>
+concept has_exact_bordered_jacobian = bordered_system<S> && requires(const S& s, const vec<double>& w, double mu) {
+  { s.bordered_jacobian(w, mu) } -> std::same_as<bordered_block_matrix<double, S::block_size>>;
+};
+
+/// A block_system or bordered_system whose block size is B: the constraint of an algorithm
+/// written for blocks of B.
+template <class S, int B>
+concept block_system_of = (block_system<S> || bordered_system<S>) && (S::block_size == B);
+
+template <class S>
+  requires block_system<S> || bordered_system<S>
 inline constexpr int block_size_of = S::block_size;
 
 /// Compile-time check of an algorithm's block size against the model's: instantiating it with
-/// a model that is no block_system, or has another block size, stops the build with this
-/// message (the caller's B and the model's are in the instantiation trace).
+/// a model that is no block_system (nor bordered_system), or has another block size, stops the
+/// build with this message (the caller's B and the model's are in the instantiation trace).
 template <int B, class S>
 constexpr void require_block_size() {
   static_assert(B > 0, "require_block_size: the algorithm's block size B must be positive");
-  if constexpr (!block_system<S>) {
-    static_assert(block_system<S>,
+  if constexpr (!block_system<S> && !bordered_system<S>) {
+    static_assert(block_system<S> || bordered_system<S>,
                   "require_block_size: the model is not a block_system (static constexpr int block_size and "
-                  "jacobians(w, mu) returning block_jacobian_pair<block_size>)");
+                  "jacobians(w, mu) returning block_jacobian_pair<block_size>) nor a bordered_system "
+                  "(bordered_jacobians(w, mu) returning bordered_jacobian_pair<block_size>)");
   } else {
     static_assert(S::block_size == B,
                   "require_block_size: the model's block_size differs from the block size B the algorithm was "
@@ -119,6 +163,77 @@ block_sparse_matrix<double, S::block_size> checked_exact_jacobian(const S& sys, 
     return a;
   } else {
     return checked_jacobians(sys, w, mu, who).exact;
+  }
+}
+
+namespace internal {
+inline void check_bordered_jacobian_size(const auto& m, Eigen::Index n, const char* which, const std::string& who) {
+  require(m.rows() == n, who, ": ", which, " bordered Jacobian is ", m.rows(), "x", m.cols(), " (", m.flow_size(),
+          " flow + ", m.structure_size(), " structural unknowns), system has ", n, " unknowns");
+}
+}  // namespace internal
+
+/// The border the Krylov path gives sys (file comment): for a model's own bordered form, its
+/// structure_size() is what it should return; for the views of the other forms, the last
+/// n - B floor(flow_size() / B) unknowns of an aeroelastic_system, else the last 1..B unknowns
+/// (0 of an empty system).
+template <int B, dynamical_system S>
+Eigen::Index krylov_border_size(const S& sys) {
+  static_assert(B > 0, "krylov_border_size: the block size B must be positive");
+  const Eigen::Index n = sys.size();
+  if constexpr (aeroelastic_system<S>) {
+    check_aeroelastic_layout(sys, "krylov_border_size");
+    return n - B * (sys.flow_size() / B);
+  } else {
+    return n == 0 ? 0 : n - B * ((n - 1) / B);
+  }
+}
+
+/// The exact and preconditioning Jacobians of sys at (w, mu) in the bordered form with flow
+/// blocks of B (file comment): a bordered_system's own (checked against size()), else the
+/// padded block_system's pair or the Eigen sparse jacobian / lhs_jacobian split at
+/// krylov_border_size<B>(sys). A model of another block size is a compile-time error. who names
+/// the caller in the messages.
+template <int B, dynamical_system S>
+bordered_jacobian_pair<B> krylov_jacobians(const S& sys, const vec<double>& w, double mu, const std::string& who) {
+  if constexpr (bordered_system<S>) {
+    require_block_size<B, S>();
+    bordered_jacobian_pair<B> p = sys.bordered_jacobians(w, mu);
+    internal::check_bordered_jacobian_size(p.exact, sys.size(), "exact", who);
+    internal::check_bordered_jacobian_size(p.preconditioning, sys.size(), "preconditioning", who);
+    return p;
+  } else if constexpr (block_system<S>) {
+    require_block_size<B, S>();
+    const Eigen::Index k = krylov_border_size<B>(sys);
+    block_jacobian_pair<B> p = checked_jacobians(sys, w, mu, who);
+    return {bordered_from_padded(p.exact, k, who), bordered_from_padded(p.preconditioning, k, who)};
+  } else {
+    static_assert(is_sparse_matrix_v<jacobian_t<S>>,
+                  "krylov_jacobians: a system without block Jacobians needs Eigen sparse ones (jacobian_type)");
+    const Eigen::Index k = krylov_border_size<B>(sys);
+    return {bordered_from_sparse<B>(sys.jacobian(w, mu), k, who), bordered_from_sparse<B>(lhs_jacobian(sys, w, mu), k, who)};
+  }
+}
+
+/// The exact matrix of krylov_jacobians alone: the model's bordered_jacobian or
+/// block_jacobian where it has one (saving the preconditioning matrix's assembly).
+template <int B, dynamical_system S>
+bordered_block_matrix<double, B> krylov_exact_jacobian(const S& sys, const vec<double>& w, double mu,
+                                                       const std::string& who) {
+  if constexpr (has_exact_bordered_jacobian<S>) {
+    require_block_size<B, S>();
+    bordered_block_matrix<double, B> a = sys.bordered_jacobian(w, mu);
+    internal::check_bordered_jacobian_size(a, sys.size(), "exact", who);
+    return a;
+  } else if constexpr (bordered_system<S>) {
+    return krylov_jacobians<B>(sys, w, mu, who).exact;
+  } else if constexpr (block_system<S>) {
+    require_block_size<B, S>();
+    return bordered_from_padded(checked_exact_jacobian(sys, w, mu, who), krylov_border_size<B>(sys), who);
+  } else {
+    static_assert(is_sparse_matrix_v<jacobian_t<S>>,
+                  "krylov_exact_jacobian: a system without block Jacobians needs Eigen sparse ones (jacobian_type)");
+    return bordered_from_sparse<B>(sys.jacobian(w, mu), krylov_border_size<B>(sys), who);
   }
 }
 
