@@ -10,9 +10,11 @@
 #include <aerohopf/bifurcation/equilibrium_krylov.hpp>
 #include <aerohopf/bifurcation/hopf.hpp>
 #include <aerohopf/bifurcation/hopf_bordered.hpp>
+#include <aerohopf/bifurcation/vg_diagram.hpp>
 #include <aerohopf/flow/naca_cgrid.hpp>
 #include <aerohopf/models/aerofoil.hpp>
 
+#include "support/bordered_test_system.hpp"
 #include "support/hopf_test_systems.hpp"
 
 #include <Eigen/Eigenvalues>
@@ -768,4 +770,78 @@ TEST(hopf_bordered_full, krylov_start_matches_the_sparse_lu_start) {
     EXPECT_LE(info.residual, 1e-10 * std::max(1.0, std::abs(info.lambda)));
     EXPECT_GT(info.linear_iterations, info.iterations);
   }
+}
+
+// ---- a structure that is not one flow block: 5 unknowns per cell and 6 structural unknowns
+// (tests/support/bordered_test_system.hpp), in the model's bordered form and through its Eigen
+// sparse Jacobians. Every Krylov consumer (equilibrium, inverse-power start, fixed-equilibrium
+// and full Hopf Newton, V-g solver factory) against the sparse-LU references ----
+namespace {
+using test_support::modal_block_system;
+using test_support::sparse_view;
+}  // namespace
+
+TEST(hopf_bordered_structure, six_structural_unknowns_with_blocks_of_five) {
+  const modal_block_system s(12);
+  const sparse_view<modal_block_system> v{s};
+  // the equilibrium: Newton-Krylov from a perturbed state, both routes the same iterates
+  vec<double> w0 = vec<double>::Constant(s.size(), 1.0);
+  w0.tail(6).setZero();
+  const auto e = solve_equilibrium_krylov<5>(s, 0.5, w0);
+  const auto ev = solve_equilibrium_krylov<5>(v, 0.5, w0);
+  EXPECT_TRUE(e.report.converged);
+  EXPECT_LE(s.residual<double>(e.w, 0.5).norm(), 1e-11);
+  EXPECT_EQ(e.linear_iterations, ev.linear_iterations);
+  EXPECT_EQ(e.w, ev.w);
+  const vec<double> w = e.w;
+  // the start: bordered BILU-GMRES inverse power against the sparse-LU one
+  eigen_pair info;
+  const hopf_point g = hopf_start_krylov<5>(s, w, 0.55, 1.0, {}, &info);
+  const hopf_point gd = hopf_start(s, w, 0.55, 1.0);
+  EXPECT_NEAR(g.omega, gd.omega, 1e-7);
+  EXPECT_GT(info.linear_iterations, 0);
+  // fixed equilibrium (the equilibrium does not depend on mu) and full: the sparse-LU Hopf point
+  hopf_options fo = fixed_options(1e-11);
+  const hopf_result ref = solve_hopf(s, g, fo);
+  ASSERT_TRUE(ref.report.converged);
+  EXPECT_GT(ref.point.mu, 0.4);
+  EXPECT_LT(ref.point.mu, 0.8);
+  const hopf_result fk = solve_hopf_krylov<5>(s, g, fo);
+  const hopf_result fv = solve_hopf_krylov<5>(v, g, fo);
+  ASSERT_TRUE(fk.report.converged);
+  EXPECT_NEAR(fk.point.mu, ref.point.mu, 1e-9);
+  EXPECT_NEAR(fk.point.omega, ref.point.omega, 1e-9);
+  EXPECT_EQ(fk.linear_iterations, fv.linear_iterations);
+  EXPECT_EQ(fk.point.mu, fv.point.mu);
+  hopf_options uo = fo;
+  uo.fixed_equilibrium = false;
+  hopf_krylov_options uk;
+  uk.full_system = true;
+  const hopf_result uref = solve_hopf(s, g, uo);
+  const hopf_result fu = solve_hopf_krylov<5>(s, g, uo, uk);
+  ASSERT_TRUE(fu.report.converged);
+  EXPECT_NEAR(fu.point.mu, uref.point.mu, 1e-9);
+  EXPECT_NEAR(fu.point.omega, uref.point.omega, 1e-9);
+  EXPECT_NEAR(fu.point.mu, ref.point.mu, 1e-9);
+  EXPECT_LE((fu.point.w - w).norm(), 1e-8);
+  // V-g: the bordered BILU-GMRES solver factory against the sparse-LU diagram
+  const std::vector<double> mus{0.45, 0.55, 0.65, 0.75};
+  const std::vector<vg_mode_start> starts{{cplx(-0.1, 1.0), {}}, {cplx(-0.2, 1.5), {}}};
+  auto equilibrium = [&](double) { return w; };
+  vg_options vo;
+  vo.inverse_power.tolerance = 1e-10;
+  const vg_result lu = vg_diagram(s, equilibrium, mus, starts, vo);
+  vg_krylov_options vk;
+  vk.krylov.relative_tolerance = 1e-12;
+  const vg_result kr = vg_diagram(s, equilibrium, mus, starts, vo, vg_krylov_solvers<5>(s, vk));
+  ASSERT_EQ(kr.points.size(), lu.points.size());
+  for (std::size_t i = 0; i < lu.points.size(); ++i)
+    EXPECT_LT(std::abs(kr.points[i].lambda - lu.points[i].lambda), 1e-8 * std::abs(lu.points[i].lambda)) << i;
+  ASSERT_EQ(kr.flutter.size(), 1u);
+  EXPECT_NEAR(kr.flutter[0].mu, ref.point.mu, 1e-3);
+  EXPECT_GT(kr.linear_iterations, 0);
+  std::cout << "n_f = 60, n_s = 6: Hopf mu* " << std::setprecision(12) << fk.point.mu << " omega* " << fk.point.omega
+            << "; fixed " << fk.report.iterations << " Newton / " << fk.linear_iterations << " GMRES, full "
+            << fu.report.iterations << " Newton / " << fu.linear_iterations << " GMRES; start " << info.iterations
+            << " inverse iterations / " << info.linear_iterations << " GMRES\n";
 }

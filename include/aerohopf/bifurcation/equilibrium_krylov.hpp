@@ -8,10 +8,12 @@
 // while Newton converges quadratically in 2-5 steps.
 //
 // Method: Newton on f(w, mu) = 0 with
-//   * the EXACT Jacobian f_w (exact_blocks: the system's block assembly, e.g. the aerofoil's
-//     second-order flow Jacobian) as the GMRES operator, so the convergence is quadratic;
-//   * right preconditioning by the real BILU(k) of lhs_jacobian (the modified-order Jacobian of
-//     the aerofoil: BILU of the exact second-order one is poor, spec 05), factorised ONCE, at the
+//   * the EXACT Jacobian f_w in the bordered form (krylov_exact_jacobian, nonlinear/block_system.hpp:
+//     flow blocks + structural border, e.g. the aerofoil's second-order flow Jacobian) as the
+//     GMRES operator, so the convergence is quadratic;
+//   * right preconditioning by the real BILU(k) of the flow part of the preconditioning matrix
+//     (the modified-order Jacobian of the aerofoil: BILU of the exact second-order one is poor,
+//     spec 05) with the border eliminated exactly (bordered_block_ilu), factorised ONCE, at the
 //     start (later iterates move w little);
 //   * the inexact-Newton forcing eta_k = min(0.5, eta_max, max(||f_k||, 0.1 tol / ||f_k||)) (GMRES
 //     relative tolerance: loose far away, quadratic near the solution, never tighter than the last
@@ -29,19 +31,22 @@
 // value). Input checks (input_error): the options, a finite mu, a finite start of the system's
 // size (the first bad entry named).
 //
-// B: block size of the unknowns for BILU (4 for 2D Euler + pitch-plunge), S any
-// dynamical_system with sparse Jacobians (with block_jacobians the assembly is shared).
+// B: block size of the flow unknowns for BILU (4 for 2D Euler), S any dynamical_system with
+// sparse Jacobians or a block_system / bordered_system of block size B (krylov_jacobians).
 #include <Eigen/Core>
 
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <string>
+#include <type_traits>
 #include <utility>
 
 #include "../error.hpp"
 #include "../linalg/block_ilu.hpp"
 #include "../linalg/block_sparse_matrix.hpp"
+#include "../linalg/bordered_block_matrix.hpp"
+#include "../nonlinear/block_system.hpp"
 #include "../linalg/krylov.hpp"
 #include "../nonlinear/newton.hpp"
 #include "../nonlinear/system.hpp"
@@ -81,15 +86,20 @@ inline double inexact_forcing(double fn, double abs_tol, double eta_max) {
   return std::min(0.5, std::min(eta_max, std::max(fn, 0.1 * abs_tol / fn)));
 }
 
-/// The Newton-Krylov equilibrium solve of solve_equilibrium_krylov with the caller's BILU object
-/// (after the call it holds the factorisation of lhs_jacobian at the start, which the fixed-equilibrium
-/// Hopf-curve tracer reuses for dw0/dnu). linear_iterations is incremented, not reset.
+/// The Newton-Krylov equilibrium solve of solve_equilibrium_krylov with the caller's
+/// preconditioner, which after the call holds the factorisation of the preconditioning matrix at
+/// the start: a bordered_block_ilu<double, B> (the bordered form of every Krylov solve), or a
+/// block_ilu<double, B> of the padded whole matrix (the form hopf_curve_fixed_equilibrium.hpp
+/// reuses for dw0/dnu). linear_iterations is incremented, not reset.
 /// Failures are thrown unless throw_on_failure is false (then returned, newton_iterate's
 /// contract); the default true is the contract of the nested solves of the Hopf-curve tracer.
-template <int B, dynamical_system S>
+template <int B, dynamical_system S, class Preconditioner>
 newton_result equilibrium_newton_krylov(const S& sys, double mu, vec<double> w, const equilibrium_krylov_options& o,
-                                        block_ilu<double, B>& ilu, long& linear_iterations, const std::string& label,
+                                        Preconditioner& ilu, long& linear_iterations, const std::string& label,
                                         bool throw_on_failure = true) {
+  constexpr bool padded = std::is_same_v<Preconditioner, block_ilu<double, B>>;
+  static_assert(padded || std::is_same_v<Preconditioner, bordered_block_ilu<double, B>>,
+                "equilibrium_newton_krylov: the preconditioner is a bordered_block_ilu<double, B> or block_ilu<double, B>");
   const Eigen::Index n = sys.size();
   require_size(w.size(), n, label, "start");
   require(std::isfinite(mu), label, ": mu is not finite (", mu, ")");
@@ -98,26 +108,32 @@ newton_result equilibrium_newton_krylov(const S& sys, double mu, vec<double> w, 
           ": Newton needs abs_tolerance > 0 or rel_tolerance > 0");
   require(o.eta_max > 0 && o.eta_max < 1, label, ": eta_max must lie in (0, 1) (got ", o.eta_max, ")");
   check_newton_options(o.newton, label);
-  const Eigen::Index padded = padded_block_count(n, B) * B;
   newton_options no = o.newton;
   no.throw_on_failure = throw_on_failure;
   if (!no.describe) no.describe = [mu](const vec<double>&) { return internal::concat("mu = ", mu); };
-  block_sparse_matrix<double, B> a;
+  std::conditional_t<padded, block_sparse_matrix<double, B>, bordered_block_matrix<double, B>> a;
   return newton_iterate(
       [&](const vec<double>& v) { return vec<double>(sys.residual(v, mu)); },
       [&](const vec<double>& v, const vec<double>& f, int k) {
-        if (k == 1) {
-          block_sparse_matrix<double, B> l;
-          std::tie(a, l) = exact_and_lhs_blocks<B>(sys, v, mu, label);
-          ilu.compute(l);
+        if constexpr (padded) {
+          if (k == 1) {
+            block_sparse_matrix<double, B> l;
+            std::tie(a, l) = exact_and_lhs_blocks<B>(sys, v, mu, label);
+            ilu.compute(l);
+          } else {
+            a = exact_blocks<B>(sys, v, mu, label);
+          }
         } else {
-          a = exact_blocks<B>(sys, v, mu, label);
+          bordered_block_matrix<double, B> l;
+          krylov_matrices<B>(sys, v, mu, k > 1, label, a, l);
+          if (k == 1) ilu.compute(l);
         }
         krylov_options ko = o.krylov;
         ko.relative_tolerance = inexact_forcing(f.norm(), o.newton.abs_tolerance, o.eta_max);
         ko.throw_on_failure = true;
         ko.context = internal::concat(label, ", GMRES at Newton iterate ", k);
-        vec<double> rhs = vec<double>::Zero(padded), dx = vec<double>::Zero(padded);
+        // the padded form's vectors are longer than n (zero padding); the bordered form's are n
+        vec<double> rhs = vec<double>::Zero(a.rows()), dx = vec<double>::Zero(a.rows());
         rhs.head(n) = -f;
         linear_iterations += gmres<double>(a, ilu, rhs, dx, ko).iterations;
         return vec<double>(dx.head(n));
@@ -138,8 +154,8 @@ equilibrium_krylov_result solve_equilibrium_krylov(const S& sys, double mu, vec<
   const auto t0 = std::chrono::steady_clock::now();
   block_ilu_options io;
   io.fill_level = o.fill_level;
-  io.context = label + ": real BILU(" + std::to_string(o.fill_level) + ") of lhs_jacobian";
-  block_ilu<double, B> ilu(io);
+  io.context = label + ": real BILU(" + std::to_string(o.fill_level) + ") of the preconditioning Jacobian";
+  bordered_block_ilu<double, B> ilu(io);
   equilibrium_krylov_result r;
   newton_result nr = internal::equilibrium_newton_krylov<B>(sys, mu, std::move(w0), o, ilu, r.linear_iterations, label,
                                                             o.newton.throw_on_failure);

@@ -36,6 +36,7 @@
 #include "../error.hpp"
 #include "../linalg/block_ilu.hpp"
 #include "../linalg/block_sparse_matrix.hpp"
+#include "../linalg/bordered_block_matrix.hpp"
 #include "../linalg/direct.hpp"
 #include "../linalg/krylov.hpp"
 #include "../linalg/operator.hpp"
@@ -52,7 +53,7 @@ namespace internal {
 
 /// The real split form of (A + dmu A_mu) - i omega I acting on v = [x_re; x_im] (n each):
 ///   r = [(A + dmu A_mu) x_re + omega x_im;  (A + dmu A_mu) x_im - omega x_re].
-/// A is a padded block matrix (rows() >= n, padding zero); A_mu (any matrix with a product) is
+/// A is a block matrix, bordered (rows() == n) or padded (rows() >= n, padding zero); A_mu (any matrix with a product) is
 /// used only when dmu != 0. The inner operator of every bordered Krylov Hopf solve.
 /// For a real block_sparse_matrix A the shifted product is one fused pass over A on the complex
 /// vector x_re + i x_im (block_sparse_matrix::apply_shifted): half the matrix traffic of two real
@@ -128,17 +129,17 @@ struct complex_preconditioner_split_form {
 }  // namespace internal
 
 /// A system that also assembles its exact and approximate (left-hand-side) Jacobians directly
-/// as block matrices of block size B, padded to a multiple of B with logical size n (e.g.
-/// models::aerofoil_system): solve_hopf_krylov then skips the Eigen sparse round trip
-/// (triplets, sort, re-blocking), about half of the assembly time on the NACA 0012 grids.
-/// block_jacobians(w, mu) gives both (exact, approximate) at once, sharing what they have in common.
+/// in blocks of block size B (a block_system or bordered_system, e.g. models::aerofoil_system):
+/// solve_hopf_krylov then skips the Eigen sparse round trip (triplets, sort, re-blocking), about
+/// half of the assembly time on the NACA 0012 grids.
 template <class S, int B>
 concept has_block_jacobians = block_system_of<S, B>;
 
 namespace internal {
-/// The exact Jacobian of sys at (w, mu) in blocks of B (padded to a multiple of B, logical size
-/// n): the block_system's own assembly (checked_exact_jacobian; its block size must be B), else
-/// from_sparse.
+/// The exact Jacobian of sys at (w, mu) as ONE padded block matrix of B (logical size n), the
+/// form the fixed-equilibrium Hopf-curve tracer works in (the Krylov strategies of this header
+/// take the bordered form, krylov_jacobians): the block_system's own assembly
+/// (checked_exact_jacobian; its block size must be B), else from_sparse.
 template <int B, dynamical_system S>
 block_sparse_matrix<double, B> exact_blocks(const S& sys, const vec<double>& w, double mu, const std::string& who) {
   if constexpr (block_system<S>) {
@@ -161,6 +162,19 @@ std::pair<block_sparse_matrix<double, B>, block_sparse_matrix<double, B>> exact_
     return {block_sparse_matrix<double, B>::from_sparse(sys.jacobian(w, mu), B),
             block_sparse_matrix<double, B>::from_sparse(lhs_jacobian(sys, w, mu), B)};
   }
+}
+/// The Krylov matrices of sys at (w, mu) in the bordered form: the exact A and, unless A itself
+/// preconditions (precondition_exact; l is then left empty), the preconditioning matrix L.
+template <int B, dynamical_system S>
+void krylov_matrices(const S& sys, const vec<double>& w, double mu, bool precondition_exact, const std::string& who,
+                     bordered_block_matrix<double, B>& a, bordered_block_matrix<double, B>& l) {
+  if (precondition_exact) {
+    a = krylov_exact_jacobian<B>(sys, w, mu, who);
+    return;
+  }
+  bordered_jacobian_pair<B> p = krylov_jacobians<B>(sys, w, mu, who);
+  a = std::move(p.exact);
+  l = std::move(p.preconditioning);
 }
 }  // namespace internal
 
@@ -471,14 +485,15 @@ class hopf_bordered_direct {
 /// (the mu column gets (A_w p) dw1 in the full formulation) applied matrix-free (the fused
 /// shifted block product of the exact Jacobian), solved by right-preconditioned GMRES. The
 /// preconditioner is the exact inverse of the same bordered matrix with A - i omega I replaced by
-/// its BILU(k) factors of the MODIFIED-ORDER L - i omega I (complex, block size B): block
-/// elimination of the two border unknowns (bordered_preconditioner), so one complex BILU
+/// its preconditioner built from the MODIFIED-ORDER L - i omega I: complex BILU(k) of the flow
+/// part (block size B), the structural border eliminated exactly (bordered_block_ilu); then block
+/// elimination of the two Hopf border unknowns (bordered_preconditioner), so one complex BILU
 /// application per GMRES iteration. J itself is non-singular at a simple Hopf point, so GMRES does
 /// not meet the near-singularity of A - i omega I. This avoids both the fill of a direct solver
 /// and the slow linear rate of the approximate left-hand side (the original scheme: modified-order
 /// L, bordering, BILU-GMRES converges at a linear rate ~0.85 on the NACA 0012 coarse grid).
 /// The full formulation's flow update is real GMRES on the exact A, preconditioned by the real
-/// BILU(k) of L; the three solves share the inexact-Newton forcing. Matrices and factorisations:
+/// bordered BILU(k) of L; the three solves share the inexact-Newton forcing. Matrices and factorisations:
 /// fixed equilibrium, reused from (mu0, omega0) while hopf_krylov_options::reuse_matrices
 /// allows; full formulation, refreshed at every iterate (A moves with w).
 ///
@@ -528,13 +543,11 @@ class hopf_bordered_krylov {
   vec<double> a_mu(const vec<double>& v) const { return amu_ * v; }
   vec<double> solve_flow(const vec<double>& b, const char* what, int it) {
     const auto t0 = internal::hopf_clock::now();
-    const Eigen::Index n = b.size(), padded = a_.rows();
-    vec<double> rhs = vec<double>::Zero(padded), d = vec<double>::Zero(padded);
-    rhs.head(n) = b;
+    vec<double> d = vec<double>::Zero(b.size());
     ko_.context = internal::concat(label_, ": GMRES on A ", what, " at Newton iteration ", it);
-    stats.linear_iterations += gmres<double>(a_, ilu_real_, rhs, d, ko_).iterations;
+    stats.linear_iterations += gmres<double>(a_, ilu_real_, b, d, ko_).iterations;
     stats.linear_seconds += internal::seconds_since(t0);
-    return d.head(n);
+    return d;
   }
   vec<double> solve_bordered(const vec<double>& mu_column, const vec<double>& pr, const vec<double>& pi,
                              const vec<double>& s, const vec<double>& rhs, int it) {
@@ -542,9 +555,9 @@ class hopf_bordered_krylov {
     const Eigen::Index n = pr.size();
     // inner operator: the real form of A - i omega I on (x_re, x_im), A = A0 + (mu - mu0) A_mu0;
     // its preconditioner: the complex BILU solve in the same form
-    const internal::real_split_shifted_operator<block_sparse_matrix<double, B>, jacobian_t<S>> inner(a_, om_, n, &amu_,
-                                                                                                   mu_ - mu0_);
-    const internal::complex_preconditioner_split_form<block_ilu<C, B>> inner_pre(ilu_, n, a_.rows());
+    const internal::real_split_shifted_operator<bordered_block_matrix<double, B>, jacobian_t<S>> inner(a_, om_, n, &amu_,
+                                                                                                     mu_ - mu0_);
+    const internal::complex_preconditioner_split_form<bordered_block_ilu<C, B>> inner_pre(ilu_, n, a_.rows());
     Eigen::MatrixXd u(2 * n, 2), vt = Eigen::MatrixXd::Zero(2, 2 * n);
     u.col(0) = mu_column;
     u.col(1) << pi, -pr;
@@ -576,8 +589,8 @@ class hopf_bordered_krylov {
     if (!assembled_ || !kopt_.reuse_matrices) refresh(prob, guess.w, prob.mu(x), prob.omega(x));
     const auto t0 = internal::hopf_clock::now();
     const double om = prob.omega(x);
-    const internal::real_split_shifted_operator<block_sparse_matrix<double, B>> shifted_a(a_, om, n);
-    const internal::complex_preconditioner_split_form<block_ilu<C, B>> pre(ilu_, n, a_.rows());
+    const internal::real_split_shifted_operator<bordered_block_matrix<double, B>> shifted_a(a_, om, n);
+    const internal::complex_preconditioner_split_form<bordered_block_ilu<C, B>> pre(ilu_, n, a_.rows());
     vec<double> v(2 * n), y(2 * n), av(2 * n);
     v << prob.p_re(x), prob.p_im(x);
     krylov_options ko = kopt_.krylov;
@@ -599,7 +612,7 @@ class hopf_bordered_krylov {
       g.p.real() = v.head(n);
       g.p.imag() = v.tail(n);
       // Rayleigh quotient of A: omega estimate (A real: lambda = (p^H A p) / (p^H p))
-      const internal::real_split_shifted_operator<block_sparse_matrix<double, B>> plain_a(a_, 0.0, n);
+      const internal::real_split_shifted_operator<bordered_block_matrix<double, B>> plain_a(a_, 0.0, n);
       plain_a(v, av);
       const C pap = C(v.head(n).dot(av.head(n)) + v.tail(n).dot(av.tail(n)),
                       v.head(n).dot(av.tail(n)) - v.tail(n).dot(av.head(n)));
@@ -628,18 +641,18 @@ class hopf_bordered_krylov {
     io.context = internal::concat(label_, ": ", kind, " BILU(", kopt_.fill_level, ") of ", of);
     return io;
   }
-  /// A (blocked for a fast SpMV), A_mu and the BILU of L - i omega I (and of L, full
-  /// formulation) at (w, mu, omega); the exact Jacobian also serves as L when precondition_exact.
+  /// A (bordered, blocked for a fast SpMV), A_mu and the bordered BILU of L - i omega I (and of
+  /// L, full formulation) at (w, mu, omega); the exact Jacobian also serves as L when
+  /// precondition_exact.
   void refresh(const hopf_problem<S>& prob, const vec<double>& w, double mu, double om) {
     const auto t0 = internal::hopf_clock::now();
     const S& sys = prob.system();
-    block_sparse_matrix<double, B> l;
-    if (kopt_.precondition_exact) a_ = internal::exact_blocks<B>(sys, w, mu, label_);
-    else std::tie(a_, l) = internal::exact_and_lhs_blocks<B>(sys, w, mu, label_);
+    bordered_block_matrix<double, B> l;
+    internal::krylov_matrices<B>(sys, w, mu, kopt_.precondition_exact, label_, a_, l);
     amu_ = jacobian_d_mu(sys, w, mu);
     mu0_ = mu;
-    const block_sparse_matrix<double, B>& pm = kopt_.precondition_exact ? a_ : l;
-    ilu_.compute(shifted(pm, C(0.0, om)));
+    const bordered_block_matrix<double, B>& pm = kopt_.precondition_exact ? a_ : l;
+    ilu_.compute(pm, C(0.0, om));
     if (!prob.fixed_equilibrium()) ilu_real_.compute(pm);
     assembled_ = true;
     stats.setup_seconds += internal::seconds_since(t0);
@@ -648,9 +661,9 @@ class hopf_bordered_krylov {
   hopf_krylov_options kopt_;
   std::string label_;
   double abs_tolerance_;
-  block_ilu<C, B> ilu_;
-  block_ilu<double, B> ilu_real_;
-  block_sparse_matrix<double, B> a_;
+  bordered_block_ilu<C, B> ilu_;
+  bordered_block_ilu<double, B> ilu_real_;
+  bordered_block_matrix<double, B> a_;
   jacobian_t<S> amu_;
   bool assembled_ = false, full_ = false;
   double mu0_ = 0, mu_ = 0, om_ = 0, last_norm_ = 0;
@@ -671,8 +684,8 @@ hopf_result solve_hopf_bordered(const S& sys, const hopf_point& guess, const hop
 
 /// Newton on the Hopf system with the exact bordered matrix, GMRES and the bordered
 /// complex-BILU(k) preconditioner of the modified-order matrix (hopf_bordered_krylov). B is the
-/// block size of the system's unknowns (4 for 2D Euler + pitch-plunge); n must be a multiple of
-/// B or is padded. The formulation: fixed equilibrium (opt.fixed_equilibrium must be set), or
+/// block size of the system's flow unknowns (4 for 2D Euler); the rest is the structural border
+/// (krylov_jacobians, nonlinear/block_system.hpp). The formulation: fixed equilibrium (opt.fixed_equilibrium must be set), or
 /// the full one with kopt.full_system (opt.fixed_equilibrium must not be set; no start
 /// refinement). opt.approximate_lhs is ignored (the preconditioner always uses lhs_jacobian, the
 /// operator always the exact Jacobian).
@@ -727,11 +740,11 @@ struct hopf_start_krylov_options {
 
 /// Start point for the Hopf Newton iteration at CFD sizes: shift-invert inverse power
 /// (inverse_power.hpp) at (w, mu) with the shift sigma = i omega_guess, each solve of
-/// (A - sigma I) y = x by complex GMRES on the exact A (the fused shifted block product),
-/// right-preconditioned by the complex BILU(k) of L - sigma I, L = lhs_jacobian (the modified-
-/// order Jacobian of the aerofoil) or A itself (precondition_exact). The matrices come from the
-/// system's block_jacobians when it has them (has_block_jacobians), else from its sparse
-/// Jacobians. Convergence as inverse_power: ||A x - lambda x||_2 <= max(tolerance max(1,
+/// (A - sigma I) y = x by complex GMRES on the exact A (the fused shifted bordered product),
+/// right-preconditioned by the complex BILU(k) of the flow part of L - sigma I with the
+/// structural border eliminated exactly (bordered_block_ilu), L the preconditioning Jacobian
+/// (the modified-order Jacobian of the aerofoil) or A itself (precondition_exact). The matrices
+/// come from krylov_jacobians (the system's bordered or block Jacobians, else its sparse ones). Convergence as inverse_power: ||A x - lambda x||_2 <= max(tolerance max(1,
 /// |lambda|), 100 eps ||A||_inf), ||x||_2 = 1; otherwise convergence_error with the last lambda.
 /// info (optional) receives the eigenpair with its iteration and GMRES counts.
 template <int B, dynamical_system S>
@@ -750,26 +763,17 @@ hopf_point hopf_start_krylov(const S& sys, const vec<double>& w, double mu, doub
           ": inverse_power.tolerance must be finite and > 0 (got ", o.inverse_power.tolerance, ")");
   const Eigen::Index n = sys.size();
   const C sigma(0.0, omega_guess);
-  block_sparse_matrix<double, B> a, l;
-  if (o.precondition_exact) a = internal::exact_blocks<B>(sys, w, mu, who);
-  else std::tie(a, l) = internal::exact_and_lhs_blocks<B>(sys, w, mu, who);
-  double a_norm = 0;  // ||A||_inf over the logical rows, the scale of the attainable residual
-  for (Eigen::Index bi = 0; bi < a.block_rows(); ++bi) {
-    Eigen::Matrix<double, B, 1> sums = Eigen::Matrix<double, B, 1>::Zero();
-    for (auto k = a.row_ptr()[bi]; k < a.row_ptr()[bi + 1]; ++k) sums += a.block_at(k).cwiseAbs().rowwise().sum();
-    for (int r = 0; r < B; ++r)
-      if (bi * B + r < n) a_norm = std::max(a_norm, sums[r]);
-  }
+  bordered_block_matrix<double, B> a, l;
+  internal::krylov_matrices<B>(sys, w, mu, o.precondition_exact, who, a, l);
+  const double a_norm = a.norm_inf();  // ||A||_inf, the scale of the attainable residual
   block_ilu_options io;
   io.fill_level = o.fill_level;
   io.context = internal::concat(who, ": complex BILU(", o.fill_level, ") of ", o.precondition_exact ? "A" : "L",
                                 " - i omega I");
-  block_ilu<C, B> ilu(io);
-  ilu.compute(shifted(o.precondition_exact ? a : l, sigma));
-  const shifted_operator<block_sparse_matrix<double, B>, C> op(a, sigma);
-  const Eigen::Index padded = a.rows();
-  vec<C> x = vec<C>::Zero(padded), y(padded), r(padded);
-  x.head(n) = internal::default_start(n);
+  bordered_block_ilu<C, B> ilu(io);
+  ilu.compute(o.precondition_exact ? a : l, sigma);
+  const shifted_operator<bordered_block_matrix<double, B>, C> op(a, sigma);
+  vec<C> x = internal::default_start(n), y(n), r(n);
   krylov_options ko = o.krylov;
   ko.throw_on_failure = true;
   eigen_pair ep;
@@ -778,19 +782,19 @@ hopf_point hopf_start_krylov(const S& sys, const vec<double>& w, double mu, doub
     y.setZero();
     ko.context = internal::concat(who, ": GMRES on A - i omega I (omega ", omega_guess, "), inverse iteration ", t);
     ep.linear_iterations += gmres<C>(op, ilu, x, y, ko).iterations;
-    const double ny2 = y.head(n).squaredNorm();
+    const double ny2 = y.squaredNorm();
     if (!(ny2 > 0) || !std::isfinite(ny2))
       throw convergence_error(internal::concat(who, ": iterate ", t, " is zero or not finite"));
-    ep.lambda = sigma + y.head(n).dot(x.head(n)) / ny2;
-    x.head(n) = y.head(n) / std::sqrt(ny2);
+    ep.lambda = sigma + y.dot(x) / ny2;
+    x = y / std::sqrt(ny2);
     a.apply_shifted(ep.lambda, x, r);
-    ep.residual = r.head(n).norm();
+    ep.residual = r.norm();
     ep.iterations = t;
     if (o.inverse_power.verbose && o.inverse_power.log)
       *o.inverse_power.log << who << " it " << t << "  lambda " << ep.lambda << "  residual " << ep.residual << "  GMRES "
                            << ep.linear_iterations << "\n";
     if (ep.residual <= std::max(o.inverse_power.tolerance * std::max(1.0, std::abs(ep.lambda)), floor)) {
-      ep.vector = x.head(n);
+      ep.vector = x;
       internal::normalise_phase(ep.vector);
       if (info) *info = ep;
       return internal::hopf_point_from(w, mu, ep);

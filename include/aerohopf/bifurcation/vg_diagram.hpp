@@ -64,6 +64,7 @@
 
 #include "../error.hpp"
 #include "../nonlinear/aeroelastic_system.hpp"
+#include "../nonlinear/block_system.hpp"
 #include "../nonlinear/system.hpp"
 #include "../linalg/direct.hpp"
 #include "../linalg/krylov_solver.hpp"
@@ -505,30 +506,37 @@ struct vg_krylov_options {
 };
 
 /// The solver factory of vg_diagram for CFD sizes, where a sparse LU of A - sigma I per inverse
-/// power is too dear: each solve (A - sigma I) y = x by complex GMRES on the exact A - sigma I,
-/// right-preconditioned by the complex BILU(k) of L - sigma I, L = lhs_jacobian (the model's
-/// preconditioning Jacobian, e.g. the aerofoil's modified-order one), assembled once per
-/// parameter value (the equilibrium is a function of it) and shifted per inverse power. Use it
-/// with vg_options::inverse_power.tolerance above krylov.relative_tolerance (1e-9 with the
-/// default 1e-10). The factory keeps a reference to sys.
+/// power is too dear: each solve (A - sigma I) y = x by complex GMRES on the exact A - sigma I in
+/// the bordered form (flow blocks of B + the structural border, krylov_border_size),
+/// right-preconditioned by the complex BILU(k) of the flow part of L - sigma I with the border
+/// eliminated exactly (bordered_krylov_solver), L = lhs_jacobian (the model's preconditioning
+/// Jacobian, e.g. the aerofoil's modified-order one), assembled once per parameter value (the
+/// equilibrium is a function of it) and shifted per inverse power. Use it with
+/// vg_options::inverse_power.tolerance above krylov.relative_tolerance (1e-9 with the default
+/// 1e-10). The factory keeps a reference to sys.
 template <int B, dynamical_system S>
+  requires is_sparse_matrix_v<jacobian_t<S>>
 auto vg_krylov_solvers(const S& sys, const vg_krylov_options& o = {}) {
-  require(o.fill_level >= 0, "vg_krylov_solvers: fill_level must be >= 0 (got ", o.fill_level, ")");
-  validate_krylov_options(o.krylov, "vg_krylov_solvers");
+  constexpr const char* who = "vg_krylov_solvers";
+  require(o.fill_level >= 0, who, ": fill_level must be >= 0 (got ", o.fill_level, ")");
+  validate_krylov_options(o.krylov, who);
   struct lhs_cache {
     double mu = NAN;
-    jacobian_t<S> l;
+    bordered_block_matrix<double, B> l;
   };
-  return [&sys, o, cache = std::make_shared<lhs_cache>()](const vec<double>& w, double mu, std::complex<double> sigma) {
+  const Eigen::Index border = krylov_border_size<B>(sys);
+  return [&sys, o, border, cache = std::make_shared<lhs_cache>()](const vec<double>& w, double mu,
+                                                                 std::complex<double> sigma) {
     if (!(mu == cache->mu)) {
-      cache->l = lhs_jacobian(sys, w, mu);
+      cache->l = bordered_from_sparse<B>(lhs_jacobian(sys, w, mu), border, "vg_krylov_solvers");
       cache->mu = mu;
     }
     krylov_solver_options ko;
     ko.fill_level = o.fill_level;
     ko.krylov = o.krylov;
-    krylov_solver<Eigen::SparseMatrix<std::complex<double>>, B> solver(ko, "V-g inverse power, complex BILU-GMRES");
-    solver.precondition_with(shifted(cache->l, sigma));
+    bordered_krylov_solver<Eigen::SparseMatrix<std::complex<double>>, B> solver(
+        border, ko, "V-g inverse power, bordered complex BILU-GMRES");
+    solver.precondition_with(cache->l, sigma);
     return solver;
   };
 }

@@ -509,20 +509,28 @@ block_sparse_matrix<std::complex<double>, B> shifted(const block_sparse_matrix<S
   return c;
 }
 
-/// A - sigma I for a real block-sparse A on complex vectors, fused into one pass over A
-/// (block_sparse_matrix::apply_shifted): the operator of the shifted Krylov solves at half the
-/// matrix traffic of the assembled shifted(A, sigma). Same product as shifted(A, sigma).apply.
-template <int B>
-class shifted_operator<block_sparse_matrix<double, B>, std::complex<double>> {
+/// A - sigma I for a real matrix with a fused shifted product on complex vectors
+/// (block_sparse_matrix::apply_shifted: one pass over A; bordered_block_matrix likewise): the
+/// operator of the shifted Krylov solves at half the matrix traffic of the assembled
+/// shifted(A, sigma). Same product as shifted(A, sigma).apply.
+template <class M>
+concept fused_shift_matrix = requires(const M& m, std::complex<double> s, const vec<std::complex<double>>& x,
+                                      vec<std::complex<double>>& y) {
+  m.apply_shifted(s, x, y);
+  { m.rows() } -> std::convertible_to<Eigen::Index>;
+};
+
+template <fused_shift_matrix M>
+class shifted_operator<M, std::complex<double>> {
  public:
-  shifted_operator(const block_sparse_matrix<double, B>& a, std::complex<double> sigma) : a_(&a), sigma_(sigma) {}
+  shifted_operator(const M& a, std::complex<double> sigma) : a_(&a), sigma_(sigma) {}
   void apply(const vec<std::complex<double>>& x, vec<std::complex<double>>& y) const { a_->apply_shifted(sigma_, x, y); }
   Eigen::Index rows() const { return a_->rows(); }
   Eigen::Index cols() const { return a_->cols(); }
   std::complex<double> shift() const { return sigma_; }
 
  private:
-  const block_sparse_matrix<double, B>* a_;
+  const M* a_;
   std::complex<double> sigma_;
 };
 

@@ -16,7 +16,7 @@
 //   bordered_block_matrix<double, 5> j(std::move(a_ff), a_fs, a_sf, a_ss);  // sizes checked
 //   j.apply(x, y);                              // y = J x (x, y of n_f + n_s entries)
 //   j.apply_shifted(sigma, xc, yc);             // yc = (J - sigma I) xc, complex vectors, one pass
-//   shifted_operator<bordered_block_matrix<double, 5>, std::complex<double>> op(j, sigma);
+//   shifted_operator<bordered_block_matrix<double, 5>, std::complex<double>> op(j, sigma);  // fused
 //   bordered_block_ilu<std::complex<double>, 5> m(opts);  m.compute(l, sigma);  // M ~ (L - sigma I)^{-1}
 //   gmres<std::complex<double>>(op, m, b, x, ko);
 //   auto jb = bordered_from_sparse<5>(sparse_j, n_s);      // the last n_s unknowns as the border
@@ -189,27 +189,11 @@ bordered_block_matrix<std::complex<double>, B> shifted(const bordered_block_matr
           std::move(ss), "shifted(bordered_block_matrix)"};
 }
 
-/// J - sigma I for a real bordered J on complex vectors without assembling it (the fused
-/// bordered_block_matrix::apply_shifted): the operator of the shifted Krylov solves.
-template <int B>
-class shifted_operator<bordered_block_matrix<double, B>, std::complex<double>> {
- public:
-  shifted_operator(const bordered_block_matrix<double, B>& a, std::complex<double> sigma) : a_(&a), sigma_(sigma) {}
-  void apply(const vec<std::complex<double>>& x, vec<std::complex<double>>& y) const { a_->apply_shifted(sigma_, x, y); }
-  Eigen::Index rows() const { return a_->rows(); }
-  Eigen::Index cols() const { return a_->cols(); }
-  std::complex<double> shift() const { return sigma_; }
-
- private:
-  const bordered_block_matrix<double, B>* a_;
-  std::complex<double> sigma_;
-};
-
 /// The preconditioner of a bordered matrix J - sigma I: BILU(k) of the flow part A_ff - sigma I
 /// and the exact elimination of the border around it (the algebra of bordered_preconditioner:
 /// Schur complement (A_ss - sigma I) - A_sf M^{-1} A_fs, dense LU), so each apply costs one BILU
-/// solve plus O(n_f n_s). A real S takes sigma = 0 only; a complex S any sigma (of a real or
-/// complex J). The BILU's symbolic phase is kept while the flow pattern does not change.
+/// solve plus O(n_f n_s). The flow part is shifted for a real J and a complex S; otherwise
+/// sigma must be 0. The BILU's symbolic phase is kept while the flow pattern does not change.
 /// Failures: as block_ilu (singular_matrix_error on a singular pivot block), and
 /// singular_matrix_error for a singular Schur complement.
 template <class S, int B>
@@ -262,7 +246,7 @@ class bordered_block_ilu {
     if constexpr (is_complex_v<S> && std::is_same_v<T, double>) {
       return shifted(a, sigma);
     } else {
-      require(sigma == S(0.0), context_, ": a shift needs a complex preconditioner");
+      require(sigma == S(0.0), context_, ": a shift needs a complex preconditioner of a real matrix");
       return a.template cast<S>();
     }
   }

@@ -19,6 +19,7 @@
 
 #include "block_ilu.hpp"
 #include "block_sparse_matrix.hpp"
+#include "bordered_block_matrix.hpp"
 #include "krylov.hpp"
 
 namespace aerohopf {
@@ -44,6 +45,48 @@ krylov_report krylov_solve(krylov_method method, const Op& a, const Pre& m, cons
     default: return gmres(a, m, b, x, opt);
   }
 }
+
+namespace internal {
+/// Runs factorise(); if it fails, records why in `failure` (solve() then refuses) and rethrows,
+/// non-finite matrix entries (input_error) as singular_matrix_error like direct_solver.
+template <class Factorise>
+void factor_recording_failure(Factorise&& factorise, std::string& failure) {
+  failure.clear();
+  try {
+    factorise();
+  } catch (const input_error& e) {
+    failure = e.what();
+    throw singular_matrix_error(e.what());
+  } catch (const error& e) {
+    failure = e.what();
+    throw;
+  }
+}
+
+/// x = A^{-1} b column by column by `method` (zero initial guess, convergence_error on failure)
+/// on vectors of the operator's `size` entries (>= the n = b.rows() logical ones, zero padding);
+/// refuses after a failed factorisation or before compute(). report: the last column's.
+template <class S, class Op, class Pre, class Rhs>
+Eigen::Matrix<S, Eigen::Dynamic, Rhs::ColsAtCompileTime> solve_columns(
+    const Op& a, const Pre& m, Eigen::Index size, Eigen::Index n, const Eigen::MatrixBase<Rhs>& b,
+    krylov_method method, krylov_options o, const std::string& failure, bool computed, const std::string& context,
+    krylov_report& report) {
+  if (!failure.empty())
+    throw singular_matrix_error(concat(context, ": solve() refused: the last factorisation failed (", failure, ")"));
+  require(computed, context, ": solve() before compute()");
+  require(b.rows() == n, context, ": right-hand side has ", b.rows(), " rows, matrix ", n);
+  Eigen::Matrix<S, Eigen::Dynamic, Rhs::ColsAtCompileTime> x(n, b.cols());
+  o.throw_on_failure = true;
+  vec<S> bp = vec<S>::Zero(size), xp(size);
+  for (Eigen::Index c = 0; c < b.cols(); ++c) {
+    bp.head(n) = b.col(c).template cast<S>();
+    xp.setZero();
+    report = krylov_solve(method, a, m, bp, xp, o);
+    x.col(c) = xp.head(n);
+  }
+  return x;
+}
+}  // namespace internal
 
 template <class Matrix, int B = Eigen::Dynamic>
 class krylov_solver {
@@ -91,21 +134,8 @@ class krylov_solver {
   /// Solves A x = b column by column (zero initial guess); throws convergence_error on failure.
   template <class Rhs>
   auto solve(const Eigen::MatrixBase<Rhs>& b) const {
-    if (!failure_.empty())
-      throw singular_matrix_error(
-          internal::concat(context_, ": solve() refused: the last factorisation failed (", failure_, ")"));
-    require(computed_, context_, ": solve() before compute()");
-    require(b.rows() == n_, context_, ": right-hand side has ", b.rows(), " rows, matrix ", n_);
-    Eigen::Matrix<scalar, Eigen::Dynamic, Rhs::ColsAtCompileTime> x(n_, b.cols());
-    krylov_options o = opt_.krylov;
-    o.throw_on_failure = true;
-    for (Eigen::Index c = 0; c < b.cols(); ++c) {
-      const vec<scalar> bp = pad_vector(vec<scalar>(b.col(c).template cast<scalar>()), a_.rows());
-      vec<scalar> xp = vec<scalar>::Zero(a_.rows());
-      report_ = krylov_solve(opt_.method, a_, ilu_, bp, xp, o);
-      x.col(c) = xp.head(n_);
-    }
-    return x;
+    return internal::solve_columns<scalar>(a_, ilu_, a_.rows(), n_, b, opt_.method, opt_.krylov, failure_, computed_,
+                                           context_, report_);
   }
 
   Eigen::Index rows() const { return n_; }
@@ -120,16 +150,7 @@ class krylov_solver {
   }
   /// BILU(k) of m; on failure records why (solve() refuses until a factorisation succeeds).
   void factor(const block_matrix& m) {
-    failure_.clear();
-    try {
-      ilu_.compute(m);
-    } catch (const input_error& e) {  // non-finite matrix entries: same exception as direct_solver
-      failure_ = e.what();
-      throw singular_matrix_error(e.what());
-    } catch (const error& e) {
-      failure_ = e.what();
-      throw;
-    }
+    internal::factor_recording_failure([&] { ilu_.compute(m); }, failure_);
   }
 
   krylov_solver_options opt_;
@@ -140,6 +161,82 @@ class krylov_solver {
   bool own_preconditioner_ = false;
   bool computed_ = false;   // a_ holds the operator of the last successful compute()
   std::string failure_;     // why the last factorisation failed ("" if it succeeded)
+  mutable krylov_report report_;
+};
+
+/// The compute/solve interface of krylov_solver for an Eigen sparse matrix in the bordered form
+/// (bordered_from_sparse: flow blocks of B and a dense border of the last border_size unknowns,
+/// no padding), preconditioned by bordered_block_ilu (BILU(k) of the flow part, the border
+/// eliminated exactly): the route for aeroelastic systems, whose structure is no flow block.
+/// A failed factorisation throws singular_matrix_error (non-finite entries included, as
+/// krylov_solver), and solve() refuses until one succeeds.
+template <class Matrix, int B>
+  requires is_sparse_matrix_v<Matrix>
+class bordered_krylov_solver {
+ public:
+  using scalar = typename Matrix::Scalar;
+  using bordered_matrix = bordered_block_matrix<scalar, B>;
+
+  explicit bordered_krylov_solver(Eigen::Index border_size, krylov_solver_options options = {},
+                                  std::string context = "bordered BILU-Krylov")
+      : opt_(std::move(options)), context_(std::move(context)), border_(border_size) {
+    require(border_ >= 0, context_, ": border size ", border_, " < 0");
+    validate_krylov_options(opt_.krylov, context_);
+    block_ilu_options io;
+    io.fill_level = opt_.fill_level;
+    io.reorder_rcm = opt_.reorder_rcm;
+    io.context = context_ + " BILU(" + std::to_string(opt_.fill_level) + ")";
+    ilu_ = bordered_block_ilu<scalar, B>(io);
+    opt_.krylov.context = context_;
+  }
+
+  bordered_krylov_solver& compute(const Matrix& a) {
+    bordered_matrix m = bordered_from_sparse<B>(a, border_, context_);
+    if (own_preconditioner_)
+      require(ilu_.rows() == m.rows(), context_, ": preconditioner matrix (precondition_with) has ", ilu_.rows(),
+              " rows, operator ", m.rows());
+    computed_ = false;
+    a_ = std::move(m);
+    if (!own_preconditioner_) factor(a_, scalar(0.0));
+    computed_ = true;
+    return *this;
+  }
+
+  /// M from the bordered BILU of m - sigma I for every later compute() (e.g. the modified-order
+  /// Jacobian for the exact one), while the Krylov method keeps the exact operator.
+  template <class T>
+  bordered_krylov_solver& precondition_with(const bordered_block_matrix<T, B>& m, scalar sigma = scalar(0.0)) {
+    factor(m, sigma);
+    own_preconditioner_ = true;
+    return *this;
+  }
+
+  /// Solves A x = b column by column (zero initial guess); throws convergence_error on failure.
+  template <class Rhs>
+  auto solve(const Eigen::MatrixBase<Rhs>& b) const {
+    return internal::solve_columns<scalar>(a_, ilu_, a_.rows(), a_.rows(), b, opt_.method, opt_.krylov, failure_,
+                                           computed_, context_, report_);
+  }
+
+  Eigen::Index rows() const { return a_.rows(); }
+  const krylov_report& last_report() const { return report_; }
+  const bordered_matrix& bordered_operator_matrix() const { return a_; }
+  const bordered_block_ilu<scalar, B>& preconditioner() const { return ilu_; }
+
+ private:
+  template <class T>
+  void factor(const bordered_block_matrix<T, B>& m, scalar sigma) {
+    internal::factor_recording_failure([&] { ilu_.compute(m, sigma); }, failure_);
+  }
+
+  krylov_solver_options opt_;
+  std::string context_;
+  Eigen::Index border_;
+  bordered_matrix a_;
+  bordered_block_ilu<scalar, B> ilu_;
+  bool own_preconditioner_ = false;
+  bool computed_ = false;
+  std::string failure_;
   mutable krylov_report report_;
 };
 
