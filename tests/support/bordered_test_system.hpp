@@ -1,19 +1,14 @@
 #pragma once
-// A small aeroelastic system whose structure is NOT one flow block (not a test itself:
-// tests/CMakeLists.txt builds only tests/<layer>/test_*.cpp): the shape of a modal wing, 5
-// unknowns per cell and 2m structural unknowns (m = 3 modes, n_s = 6), in the bordered form.
-//
-//   w = [u (5 per cell, `cells` cells), q (3 modal displacements), v (3 modal velocities)]
-//   f_u = -D z - 0.1 z.^3 + G q + b,      z = u - u0  (D block tridiagonal, dominant: a stable "flow")
-//   f_q = v
-//   f_v = -K q - (C - mu I) v + P z       K = diag(1, 2.25, 4), C = diag(0.6, 0.9, 1.2)
-//
-// The equilibrium does not depend on mu (v = 0 there), so the fixed-equilibrium Hopf system
-// applies; the coupling G, P is weak, so the first mode's damping C_11 - mu crosses zero near
-// mu = 0.6 with omega near 1 (a Hopf point). Exact Jacobian: -D - 0.3 diag(z.^2) in the flow
-// part; the preconditioning one drops the cubic term (-D), as a modified-order flow Jacobian
-// differs from the exact one. Meets bordered_system (block_size 5) and aeroelastic_system;
-// sparse_view<> hides the bordered form (the same system through its Eigen sparse Jacobians).
+// modal_block_system: the shape of a modal wing in a few dozen unknowns (5 per cell, 3 modes so
+// 6 structural unknowns: the structure is no flow block), in the bordered form. Not a test itself
+// (tests/CMakeLists.txt builds only tests/<layer>/test_*.cpp).
+// Unknowns: u per cell, modal displacements q, modal velocities v. Flow rows: a stable block
+// tridiagonal -D on z = u - u0, a cubic -0.1 z^3, the modal forcing G q and a constant load b.
+// Structural rows: q' = v, v' = -K q - (C - mu) v + P z with K = diag(1, 2.25, 4) and
+// C = diag(0.6, 0.9, 1.2). The equilibrium has v = 0 for every mu (fixed-equilibrium Hopf
+// applies) and the weak coupling puts the first mode's Hopf point near mu = 0.6, omega = 1.
+// The preconditioning Jacobian drops the cubic term, as a modified-order flow Jacobian differs
+// from the exact one. sparse_view<S> shows the same system through Eigen sparse Jacobians only.
 #include <aerohopf/linalg/bordered_block_matrix.hpp>
 #include <aerohopf/nonlinear/aeroelastic_system.hpp>
 #include <aerohopf/nonlinear/block_system.hpp>
@@ -28,9 +23,9 @@ namespace aerohopf::test_support {
 
 class modal_block_system {
  public:
+  static constexpr int block_size = 5;  // unknowns per cell
+  static constexpr int modes = 3;       // 2 * modes structural unknowns
   using jacobian_type = Eigen::SparseMatrix<double>;
-  static constexpr int block_size = 5;
-  static constexpr int modes = 3;
 
   explicit modal_block_system(Eigen::Index cells = 12) : nc_(cells), nf_(cells * block_size) {
     auto pseudo = [](double a, double b) { return std::sin(12.9898 * a + 78.233 * b); };

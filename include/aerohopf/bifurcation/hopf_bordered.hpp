@@ -53,8 +53,9 @@ namespace internal {
 
 /// The real split form of (A + dmu A_mu) - i omega I acting on v = [x_re; x_im] (n each):
 ///   r = [(A + dmu A_mu) x_re + omega x_im;  (A + dmu A_mu) x_im - omega x_re].
-/// A is a block matrix, bordered (rows() == n) or padded (rows() >= n, padding zero); A_mu (any matrix with a product) is
-/// used only when dmu != 0. The inner operator of every bordered Krylov Hopf solve.
+/// A is a block matrix, bordered (rows() == n) or padded (rows() >= n, padding zero); A_mu (any
+/// matrix with a product) is used only when dmu != 0. The inner operator of every bordered
+/// Krylov Hopf solve.
 /// For a real block_sparse_matrix A the shifted product is one fused pass over A on the complex
 /// vector x_re + i x_im (block_sparse_matrix::apply_shifted): half the matrix traffic of two real
 /// products; other matrix types take the two real products.
@@ -493,8 +494,8 @@ class hopf_bordered_direct {
 /// and the slow linear rate of the approximate left-hand side (the original scheme: modified-order
 /// L, bordering, BILU-GMRES converges at a linear rate ~0.85 on the NACA 0012 coarse grid).
 /// The full formulation's flow update is real GMRES on the exact A, preconditioned by the real
-/// bordered BILU(k) of L; the three solves share the inexact-Newton forcing. Matrices and factorisations:
-/// fixed equilibrium, reused from (mu0, omega0) while hopf_krylov_options::reuse_matrices
+/// bordered BILU(k) of L; the three solves share the inexact-Newton forcing. Matrices and
+/// factorisations: fixed equilibrium, reused from (mu0, omega0) while hopf_krylov_options::reuse_matrices
 /// allows; full formulation, refreshed at every iterate (A moves with w).
 ///
 /// Measured on the NACA 0012 pitch-plunge (light case, M = 0.5, one core; examples/aerofoil_flutter),

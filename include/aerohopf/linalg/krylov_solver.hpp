@@ -47,6 +47,18 @@ krylov_report krylov_solve(krylov_method method, const Op& a, const Pre& m, cons
 }
 
 namespace internal {
+/// Validates a Krylov solver's options (input_error naming context), gives its Krylov method the
+/// context, and returns the options of its BILU(k).
+inline block_ilu_options prepare_krylov_solver(krylov_solver_options& opt, const std::string& context) {
+  validate_krylov_options(opt.krylov, context);
+  opt.krylov.context = context;
+  block_ilu_options io;
+  io.fill_level = opt.fill_level;
+  io.reorder_rcm = opt.reorder_rcm;
+  io.context = context + " BILU(" + std::to_string(opt.fill_level) + ")";
+  return io;
+}
+
 /// Runs factorise(); if it fails, records why in `failure` (solve() then refuses) and rethrows,
 /// non-finite matrix entries (input_error) as singular_matrix_error like direct_solver.
 template <class Factorise>
@@ -98,13 +110,7 @@ class krylov_solver {
       : opt_(std::move(options)), context_(std::move(context)) {
     if (B != Eigen::Dynamic) opt_.block_size = B;
     require(opt_.block_size > 0, context_, ": block size ", opt_.block_size, " <= 0");
-    validate_krylov_options(opt_.krylov, context_);
-    block_ilu_options io;
-    io.fill_level = opt_.fill_level;
-    io.reorder_rcm = opt_.reorder_rcm;
-    io.context = context_ + " BILU(" + std::to_string(opt_.fill_level) + ")";
-    ilu_ = block_ilu<scalar, B>(io);
-    opt_.krylov.context = context_;
+    ilu_ = block_ilu<scalar, B>(internal::prepare_krylov_solver(opt_, context_));
   }
 
   krylov_solver& compute(const Matrix& a) {
@@ -181,13 +187,7 @@ class bordered_krylov_solver {
                                   std::string context = "bordered BILU-Krylov")
       : opt_(std::move(options)), context_(std::move(context)), border_(border_size) {
     require(border_ >= 0, context_, ": border size ", border_, " < 0");
-    validate_krylov_options(opt_.krylov, context_);
-    block_ilu_options io;
-    io.fill_level = opt_.fill_level;
-    io.reorder_rcm = opt_.reorder_rcm;
-    io.context = context_ + " BILU(" + std::to_string(opt_.fill_level) + ")";
-    ilu_ = bordered_block_ilu<scalar, B>(io);
-    opt_.krylov.context = context_;
+    ilu_ = bordered_block_ilu<scalar, B>(internal::prepare_krylov_solver(opt_, context_));
   }
 
   bordered_krylov_solver& compute(const Matrix& a) {
