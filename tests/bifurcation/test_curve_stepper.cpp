@@ -111,6 +111,19 @@ struct scripted_circle {
 };
 
 double angle(const vec<double>& x) { return std::atan2(x[1], x[0]); }
+
+/// The scripted circle with `tamper(result, step requests so far)` applied to every corrected
+/// point (a corrector that jumps).
+template <class Tamper>
+auto tampered(scripted_circle& p, Tamper tamper) {
+  return curve_problem{[&p, tamper](const curve_request& r, std::string& why) -> std::optional<curve_corrected> {
+                         auto c = p.correct(r, why);
+                         if (c) tamper(*c, p.steps.size());
+                         return c;
+                       },
+                       [&p](const vec<double>& x, const vec<double>& c) { return p.tangent(x, c); },
+                       [&p](const vec<double>& x, const curve_point_info& i) { return p.emit(x, i); }};
+}
 const curve_metric euclid(vec<double>::Ones(2));
 const vec<double> east = v2(1, 0), north = v2(0, 1);
 
@@ -307,14 +320,10 @@ TEST(curve_stepper, tangent_predictor_passes_the_turning_point_of_the_fold) {
 TEST(curve_stepper, sheet_jump_guard_rejects_a_point_behind_the_last_one) {
   auto run = [](bool guard) {
     scripted_circle p;
-    curve_problem q{[&](const curve_request& r, std::string& why) -> std::optional<curve_corrected> {
-                      auto c = p.correct(r, why);
-                      // the third step request lands on the mirror image of its prediction
-                      if (c && p.steps.size() == 3) c->x[1] = -c->x[1];
-                      return c;
-                    },
-                    [&](const vec<double>& x, const vec<double>& c) { return p.tangent(x, c); },
-                    [&](const vec<double>& x, const curve_point_info& i) { return p.emit(x, i); }};
+    // the third step request lands on the mirror image of its prediction
+    auto q = tampered(p, [](curve_corrected& c, std::size_t steps) {
+      if (steps == 3) c.x[1] = -c.x[1];
+    });
     curve_stepper_options o;
     o.step = 0.2;
     o.max_step = 0.2;
@@ -349,14 +358,9 @@ TEST(curve_stepper, retrace_test) {
   // On the circle with steps of 0.25: the 9th step request returns the 2nd point (angle ~0.25).
   auto run = [](bool guard) {
     scripted_circle p;
-    std::vector<vec<double>> firsts;
-    curve_problem q{[&](const curve_request& r, std::string& why) -> std::optional<curve_corrected> {
-                      auto c = p.correct(r, why);
-                      if (c && p.steps.size() == 9) c->x = p.rec.x[1] + v2(0.01, 0.0);
-                      return c;
-                    },
-                    [&](const vec<double>& x, const vec<double>& c) { return p.tangent(x, c); },
-                    [&](const vec<double>& x, const curve_point_info& i) { return p.emit(x, i); }};
+    auto q = tampered(p, [&p](curve_corrected& c, std::size_t steps) {
+      if (steps == 9) c.x = p.rec.x[1] + v2(0.01, 0.0);
+    });
     curve_stepper_options o;
     o.step = 0.25;
     o.max_step = 0.25;

@@ -301,18 +301,50 @@ struct hopf_curve_layout {
   std::string describe(const vec<double>& x) const {
     return concat("nu = ", x[inu], ", mu = ", x[imu], ", omega = ", x[iom]);
   }
+  /// The rows of G after the flow: A p_r + omega p_i, A p_i - omega p_r (exact matrix-free
+  /// products at the flow state w), s.p_r, s.p_i - 1 and the constraint c.y - value.
+  template <class S>
+  void eigen_rows(const S& sys, const vec<double>& w, const vec<double>& x, const vec<double>& s,
+                  const std::array<double, 3>& c, double value, vec<double>& f) const {
+    const double mu = x[imu], nu = x[inu], om = x[iom];
+    const vec<double> pr = x.segment(ipr, n), pi = x.segment(ipi, n);
+    f.segment(ipr, n) = jacobian_product(sys, w, mu, pr) + om * pi;
+    f.segment(ipi, n) = jacobian_product(sys, w, mu, pi) - om * pr;
+    f[imu] = s.dot(pr);
+    f[inu] = s.dot(pi) - 1.0;
+    f[iom] = c[0] * mu + c[1] * nu + c[2] * om - value;
+  }
 };
+
+/// The input checks both tracers make first (input_error naming what is wrong).
+inline void check_curve_trace(const hopf_curve_options& opt, double nu0, int direction) {
+  const std::string& lab = opt.label;
+  require(std::isfinite(nu0), lab, ": nu0 is not finite");
+  check_curve_options(opt, lab);
+  require(nu0 >= opt.nu_min && nu0 <= opt.nu_max, lab, ": nu0 = ", nu0, " outside [nu_min, nu_max]");
+  require(direction == 1 || direction == -1, lab, ": direction must be +1 or -1");
+}
+
+/// A start of n unknowns (w, p finite and of that size; mu, omega finite).
+inline void check_curve_start(const hopf_point& start, Eigen::Index n, const std::string& lab) {
+  require(n > 0, lab, ": family(nu0) has no unknowns");
+  require_size(start.w.size(), n, lab, "start.w (equilibrium at nu0)");
+  require_size(start.p.size(), n, lab, "start.p (eigenvector)");
+  require_finite(start.w, lab, "start.w (equilibrium at nu0)");
+  require_finite(start.p, lab, "start.p (eigenvector)");
+  require(std::isfinite(start.mu) && std::isfinite(start.omega), lab, ": start mu or omega is not finite (", start.mu,
+          ", ", start.omega, ")");
+}
 
 /// The stepper options of a Hopf-curve tracer: step control, sheet-jump guard, landings on
 /// nu_targets and on the finite bounds of nu and mu (in that order), closed-curve detection.
 inline curve_stepper_options hopf_curve_stepper_options(const hopf_curve_options& opt, const hopf_curve_layout& L) {
-  curve_stepper_options so;
-  so.step = opt.step;
-  so.min_step = opt.min_step;
-  so.max_step = opt.max_step;
-  so.growth = opt.growth;
-  so.fast_iterations = opt.fast_iterations;
-  so.max_points = opt.max_points;
+  curve_stepper_options so{.step = opt.step,
+                           .min_step = opt.min_step,
+                           .max_step = opt.max_step,
+                           .growth = opt.growth,
+                           .fast_iterations = opt.fast_iterations,
+                           .max_points = opt.max_points};
   so.predictor = curve_predictor::secant;
   so.retry_exact_tangent = true;
   so.sheet_guard = true;
@@ -478,16 +510,41 @@ Result run_hopf_curve(Corrector& corr, const hopf_curve_layout& L, vec<double> x
   }
 }
 
-/// The corrector of the full Hopf curve: Newton on G (file comment) with the sparse or dense LU
-/// of J_G, nu-derivatives by central differences of the family.
+/// What the correctors of both tracers share: the layout, the options, the nu step of the
+/// central differences, and family members checked for the size of family(nu0).
 template <system_family F>
-class hopf_curve_corrector {
+class hopf_curve_corrector_base {
  public:
   using S = family_system_t<F>;
   using M = jacobian_t<S>;
 
+ protected:
+  hopf_curve_corrector_base(const hopf_curve_layout& L, const hopf_curve_options& opt) : L_(L), opt_(opt) {}
+  /// h of the nu differences: nu_step, or cbrt(eps) max(1, |nu|) (error O(h^2))
+  double nu_h(double nu) const {
+    return opt_.nu_step > 0 ? opt_.nu_step : std::cbrt(Eigen::NumTraits<double>::epsilon()) * std::max(1.0, std::abs(nu));
+  }
+  const S& system_at(family_cache<F, S>& cache, double nu) const {
+    const S& sys = cache.at(nu);
+    require(sys.size() == L_.n, opt_.label, ": family(", nu, ") has ", sys.size(), " unknowns, family(nu0) ", L_.n);
+    return sys;
+  }
+  const hopf_curve_layout& L_;
+  const hopf_curve_options& opt_;
+};
+
+/// The corrector of the full Hopf curve: Newton on G (file comment) with the sparse or dense LU
+/// of J_G, nu-derivatives by central differences of the family.
+template <system_family F>
+class hopf_curve_corrector : hopf_curve_corrector_base<F> {
+  using base = hopf_curve_corrector_base<F>;
+  using base::L_, base::opt_, base::nu_h, base::system_at;
+
+ public:
+  using typename base::S, typename base::M;
+
   hopf_curve_corrector(const F& family, const hopf_curve_layout& L, const hopf_curve_options& opt)
-      : L_(L), opt_(opt), cur_(family), plus_(family), minus_(family), lu_(opt.label + ": extended Hopf Jacobian") {}
+      : base(L, opt), cur_(family), plus_(family), minus_(family), lu_(opt.label + ": extended Hopf Jacobian") {}
 
   /// Newton on G from q.x0 with the last row q.c.X = q.value. A converged point passes the
   /// post-checks of hopf.hpp: f is the first block of G, so ||f(w, mu)|| <= the resolved ||G||
@@ -542,27 +599,13 @@ class hopf_curve_corrector {
 
  private:
   using row = std::array<double, 3>;
-  double nu_h(double nu) const {
-    return opt_.nu_step > 0 ? opt_.nu_step : std::cbrt(Eigen::NumTraits<double>::epsilon()) * std::max(1.0, std::abs(nu));
-  }
-  const S& system_at(family_cache<F, S>& cache, double nu) {
-    const S& sys = cache.at(nu);
-    require(sys.size() == L_.n, opt_.label, ": family(", nu, ") has ", sys.size(), " unknowns, family(nu0) ", L_.n);
-    return sys;
-  }
   // G(X) with the last row c.y - value
   vec<double> residual(const vec<double>& x, const vec<double>& s, const row& c, double value) {
-    const Eigen::Index n = L_.n;
-    const double mu = x[L_.imu], nu = x[L_.inu], om = x[L_.iom];
-    const S& sys = system_at(cur_, nu);
-    const vec<double> w = x.head(n), pr = x.segment(L_.ipr, n), pi = x.segment(L_.ipi, n);
+    const S& sys = system_at(cur_, x[L_.inu]);
+    const vec<double> w = x.head(L_.n);
     vec<double> f(L_.N);
-    f.head(n) = sys.residual(w, mu);
-    f.segment(L_.ipr, n) = jacobian_product(sys, w, mu, pr) + om * pi;
-    f.segment(L_.ipi, n) = jacobian_product(sys, w, mu, pi) - om * pr;
-    f[L_.imu] = s.dot(pr);
-    f[L_.inu] = s.dot(pi) - 1.0;
-    f[L_.iom] = c[0] * mu + c[1] * nu + c[2] * om - value;
+    f.head(L_.n) = sys.residual(w, x[L_.imu]);
+    L_.eigen_rows(sys, w, x, s, c, value, f);
     return f;
   }
   M jacobian(const vec<double>& x, const vec<double>& s, const row& c) {
@@ -600,8 +643,6 @@ class hopf_curve_corrector {
     return j.build();
   }
 
-  const hopf_curve_layout& L_;
-  const hopf_curve_options& opt_;
   family_cache<F, S> cur_, plus_, minus_;
   direct_solver<M> lu_;
 };
@@ -618,10 +659,7 @@ hopf_curve_result trace_hopf_curve(const F& family, double nu0, const hopf_point
   using clock = std::chrono::steady_clock;
   const std::string& lab = opt.label;
   const auto t_begin = clock::now();
-  require(std::isfinite(nu0), lab, ": nu0 is not finite");
-  internal::check_curve_options(opt, lab);
-  require(nu0 >= opt.nu_min && nu0 <= opt.nu_max, lab, ": nu0 = ", nu0, " outside [nu_min, nu_max]");
-  require(direction == 1 || direction == -1, lab, ": direction must be +1 or -1");
+  internal::check_curve_trace(opt, nu0, direction);
   require(!opt.start.fixed_equilibrium, lab, ": the fixed-equilibrium Hopf system is not supported (w depends on nu)");
 
   // ---- converge the start at fixed nu0 ----
@@ -631,13 +669,7 @@ hopf_curve_result trace_hopf_curve(const F& family, double nu0, const hopf_point
   {
     const S sys0 = family(nu0);
     n = sys0.size();
-    require(n > 0, lab, ": family(nu0) has no unknowns");
-    require_size(start.w.size(), n, lab, "start.w (equilibrium at nu0)");
-    require_size(start.p.size(), n, lab, "start.p (eigenvector)");
-    require_finite(start.w, lab, "start.w (equilibrium at nu0)");
-    require_finite(start.p, lab, "start.p (eigenvector)");
-    require(std::isfinite(start.mu) && std::isfinite(start.omega), lab, ": start mu or omega is not finite (",
-            start.mu, ", ", start.omega, ")");
+    internal::check_curve_start(start, n, lab);
     hopf_options ho = opt.start;
     ho.label = lab + ": start point at nu = " + internal::concat(nu0);
     const hopf_problem<S> prob(sys0, start, ho, "solve_hopf");

@@ -237,10 +237,12 @@ namespace internal {
 /// costs per emitted point. For run_hopf_curve; its pieces are usable alone (tests).
 template <int B, system_family F>
   requires is_sparse_matrix_v<jacobian_t<family_system_t<F>>>
-class fixed_equilibrium_hopf_corrector {
+class fixed_equilibrium_hopf_corrector : hopf_curve_corrector_base<F> {
+  using base = hopf_curve_corrector_base<F>;
+  using base::L_, base::opt_, base::nu_h, base::system_at;
+
  public:
-  using S = family_system_t<F>;
-  using M = jacobian_t<S>;
+  using typename base::S, typename base::M;
   using C = std::complex<double>;
   using clock = std::chrono::steady_clock;
   using real_block = block_sparse_matrix<double, B>;
@@ -257,7 +259,7 @@ class fixed_equilibrium_hopf_corrector {
   fixed_equilibrium_hopf_corrector(const F& family, const hopf_curve_layout& L, const hopf_curve_options& opt,
                                    const fixed_equilibrium_hopf_curve_options& sopt,
                                    fixed_equilibrium_hopf_curve_result& res, family_cache<F, S> cur)
-      : L_(L), opt_(opt), sopt_(sopt), res_(res), cur_(std::move(cur)), plus_(family), minus_(family), aux_(family),
+      : base(L, opt), sopt_(sopt), res_(res), cur_(std::move(cur)), plus_(family), minus_(family), aux_(family),
         padded_(padded_block_count(L.n, B) * B), rilu_(ilu_options("real BILU(", "of the steady Newton matrix")),
         cilu_(ilu_options("complex BILU(", "of L - i omega I")), joint_now_(sopt.joint_equilibrium) {}
 
@@ -484,14 +486,6 @@ class fixed_equilibrium_hopf_corrector {
     o.context = concat(opt_.label, ": ", what, sopt_.fill_level, ") ", of);
     return o;
   }
-  double nu_h(double nu) const {
-    return opt_.nu_step > 0 ? opt_.nu_step : std::cbrt(Eigen::NumTraits<double>::epsilon()) * std::max(1.0, std::abs(nu));
-  }
-  const S& system_at(family_cache<F, S>& cache, double nu) {
-    const S& s = cache.at(nu);
-    require(s.size() == L_.n, opt_.label, ": family(", nu, ") has ", s.size(), " unknowns, family(nu0) ", L_.n);
-    return s;
-  }
   vec<double> pad(const vec<double>& v) const {
     vec<double> r = vec<double>::Zero(padded_);
     r.head(L_.n) = v;
@@ -589,16 +583,8 @@ class fixed_equilibrium_hopf_corrector {
   // in the joint one)
   vec<double> hopf_residual(const vec<double>& x, const vec<double>& w, const vec<double>& s, const row& c,
                             double value) {
-    const Eigen::Index n = L_.n;
-    const double mu = x[L_.imu], nu = x[L_.inu], om = x[L_.iom];
-    const S& sys = system_at(cur_, nu);
-    const vec<double> pr = x.segment(L_.ipr, n), pi = x.segment(L_.ipi, n);
     vec<double> f(L_.N);
-    f.segment(L_.ipr, n) = jacobian_product(sys, w, mu, pr) + om * pi;
-    f.segment(L_.ipi, n) = jacobian_product(sys, w, mu, pi) - om * pr;
-    f[L_.imu] = s.dot(pr);
-    f[L_.inu] = s.dot(pi) - 1.0;
-    f[L_.iom] = c[0] * mu + c[1] * nu + c[2] * om - value;
+    L_.eigen_rows(system_at(cur_, x[L_.inu]), w, x, s, c, value, f);
     return f;
   }
   // Solves J(x) dx = rhs (J with the last row c) by GMRES with the bordered complex-BILU
@@ -689,8 +675,6 @@ class fixed_equilibrium_hopf_corrector {
                                      " lies ", d, " from the prediction (more than ", radius, ")"));
   }
 
-  const hopf_curve_layout& L_;
-  const hopf_curve_options& opt_;
   const fixed_equilibrium_hopf_curve_options& sopt_;
   fixed_equilibrium_hopf_curve_result& res_;
   family_cache<F, S> cur_, plus_, minus_, aux_;  // aux_: dw0/dnu at a cached nu other than the current one
@@ -713,15 +697,11 @@ template <int B, system_family F>
 fixed_equilibrium_hopf_curve_result trace_fixed_equilibrium_hopf_curve(const F& family, double nu0, const hopf_point& start,
                                                        const hopf_curve_options& opt = {}, int direction = +1,
                                                        const fixed_equilibrium_hopf_curve_options& sopt = {}) {
-  using S = family_system_t<F>;
-  using M = jacobian_t<S>;
   using clock = std::chrono::steady_clock;
-  const std::string& lab = opt.label;
   const auto t_begin = clock::now();
-  require(std::isfinite(nu0), lab, ": nu0 is not finite");
-  internal::check_curve_options(opt, lab);
-  require(nu0 >= opt.nu_min && nu0 <= opt.nu_max, lab, ": nu0 = ", nu0, " outside [nu_min, nu_max]");
-  require(direction == 1 || direction == -1, lab, ": direction must be +1 or -1");
+  using S = family_system_t<F>;
+  const std::string& lab = opt.label;
+  internal::check_curve_trace(opt, nu0, direction);
   require(sopt.fill_level >= 0, lab, ": fill level ", sopt.fill_level, " < 0");
   require(sopt.eta_max > 0 && sopt.eta_max < 1 && sopt.tangent_tolerance > 0 && sopt.tangent_tolerance < 1 &&
               sopt.derivative_tolerance > 0 && sopt.derivative_tolerance < 1,
@@ -736,20 +716,14 @@ fixed_equilibrium_hopf_curve_result trace_fixed_equilibrium_hopf_curve(const F& 
   require(sopt.krylov.max_iterations >= 1 && sopt.krylov.restart >= 1, lab,
           ": krylov.max_iterations and krylov.restart must be >= 1 (got ", sopt.krylov.max_iterations, ", ",
           sopt.krylov.restart, ")");
-  require(std::isfinite(start.mu) && std::isfinite(start.omega), lab, ": start mu or omega is not finite (", start.mu,
-          ", ", start.omega, ")");
   require(sopt.iterate_distance > 0, lab, ": iterate_distance must be > 0 (got ", sopt.iterate_distance, ")");
   require(std::isfinite(sopt.kink_distance) && sopt.kink_distance > 0, lab,
           ": kink_distance must be finite and > 0 (got ", sopt.kink_distance, ")");
 
   internal::family_cache<F, S> cur(family);
   const Eigen::Index n = cur.at(nu0).size();
-  require(n > 0, lab, ": family(nu0) has no unknowns");
-  require_size(start.w.size(), n, lab, "start.w (equilibrium at nu0)");
-  require_size(start.p.size(), n, lab, "start.p (eigenvector)");
-  require_finite(start.w, lab, "start.w (equilibrium at nu0)");
-  require_finite(start.p, lab, "start.p (eigenvector)");
-  const internal::hopf_curve_layout L(n, false, opt, resolve_normalisation<M>(opt.normalisation));
+  internal::check_curve_start(start, n, lab);
+  const internal::hopf_curve_layout L(n, false, opt, resolve_normalisation<jacobian_t<S>>(opt.normalisation));
 
   fixed_equilibrium_hopf_curve_result res;
   internal::fixed_equilibrium_hopf_corrector<B, F> corr(family, L, opt, sopt, res, std::move(cur));
