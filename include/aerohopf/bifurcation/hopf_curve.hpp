@@ -339,12 +339,9 @@ inline void check_curve_start(const hopf_point& start, Eigen::Index n, const std
 /// The stepper options of a Hopf-curve tracer: step control, sheet-jump guard, landings on
 /// nu_targets and on the finite bounds of nu and mu (in that order), closed-curve detection.
 inline curve_stepper_options hopf_curve_stepper_options(const hopf_curve_options& opt, const hopf_curve_layout& L) {
-  curve_stepper_options so{.step = opt.step,
-                           .min_step = opt.min_step,
-                           .max_step = opt.max_step,
-                           .growth = opt.growth,
-                           .fast_iterations = opt.fast_iterations,
-                           .max_points = opt.max_points};
+  curve_stepper_options so;
+  so.step = opt.step, so.min_step = opt.min_step, so.max_step = opt.max_step;
+  so.growth = opt.growth, so.fast_iterations = opt.fast_iterations, so.max_points = opt.max_points;
   so.predictor = curve_predictor::secant;
   so.retry_exact_tangent = true;
   so.sheet_guard = true;
