@@ -44,6 +44,7 @@
 #include "../linalg/assemble.hpp"
 #include "../nonlinear/newton.hpp"
 #include "../nonlinear/system.hpp"
+#include "curve_stepper.hpp"
 #include "hopf.hpp"
 
 namespace aerohopf {
@@ -157,51 +158,91 @@ void evaluate_spectrum(const S& sys, branch_point& bp, const continuation_option
 }
 }  // namespace internal
 
-/// Natural-parameter continuation: mu_k = mu0 + k dmu (opt.ds), k = 1..opt.max_steps.
+namespace internal {
+/// The stepper options shared by both equilibrium continuations.
+inline curve_stepper_options continuation_stepper_options(const continuation_options& o, Eigen::Index n,
+                                                          const char* who) {
+  curve_stepper_options so;
+  so.max_points = o.max_steps + 1;  // the start and max_steps steps
+  so.limits.push_back({n, o.mu_min, o.mu_max});
+  so.label = who;
+  so.verbose = o.verbose;
+  so.log = o.log;
+  return so;
+}
+}  // namespace internal
+
+/// Natural-parameter continuation: mu_k = mu0 + k dmu (opt.ds), k = 1..opt.max_steps: the curve
+/// stepper's natural predictor with Newton at fixed mu as the corrector.
 template <dynamical_system S>
 continuation_result natural_continuation(const S& sys, const vec<double>& w0, double mu0,
                                          const continuation_options& opt = {}) {
   const char* who = "natural_continuation";
+  const Eigen::Index n = sys.size();
   check_continuation_options(opt, who, true);
   check_state(sys, w0, mu0, who);
   continuation_result res;
   newton_options no;
   no.abs_tolerance = opt.corrector_tolerance;
   no.max_iterations = opt.corrector_iterations;
-  vec<double> w = w0;
-  for (int k = 0; k <= opt.max_steps; ++k) {
-    const double mu = mu0 + k * opt.ds;
-    if (mu < opt.mu_min || mu > opt.mu_max) {
+  // point k (its Newton solve and spectrum) fails with this context
+  auto context = [&] {
+    const std::size_t k = res.points.size();
+    return internal::concat(who, ": step ", k, " at mu = ", mu0 + double(k) * opt.ds,
+                            res.points.empty() ? std::string()
+                                               : internal::concat(" (from mu = ", res.points.back().mu, ")"),
+                            " failed (a fold? use pseudo-arclength): ");
+  };
+  auto solve = [&](const vec<double>& w, double mu) {
+    curve_corrected c;
+    const newton_result nr = newton(sys, w, mu, no);
+    c.x.resize(n + 1);
+    c.x.head(n) = nr.x;
+    c.x[n] = mu;
+    c.iterations = nr.report.iterations;
+    return c;
+  };
+  int start_iterations = 0;
+  curve_problem prob{
+      [&](const curve_request& q, std::string&) -> std::optional<curve_corrected> {
+        return solve(q.x0.head(n), q.value);  // a failure throws: it ends the run
+      },
+      nullptr,
+      [&](const vec<double>& x, const curve_point_info& info) {
+        branch_point bp;
+        bp.mu = x[n];
+        bp.w = x.head(n);
+        bp.tangent_mu = 1;
+        bp.newton_iterations = info.start ? start_iterations : info.iterations;
+        if (opt.detect_hopf) internal::evaluate_spectrum(sys, bp, opt);
+        res.points.push_back(std::move(bp));
+        return false;
+      }};
+  try {
+    if (mu0 < opt.mu_min || mu0 > opt.mu_max) {
       res.stop_reason = "left the mu interval";
-      break;
-    }
-    const std::string ctx = internal::concat(who, ": step ", k, " at mu = ", mu,
-                                             res.points.empty() ? std::string()
-                                                                : internal::concat(" (from mu = ", res.points.back().mu, ")"),
-                                             " failed (a fold? use pseudo-arclength): ");
-    branch_point bp;
-    try {
-      const newton_result nr = newton(sys, w, mu, no);
-      bp.mu = mu;
-      bp.w = nr.x;
-      bp.tangent_mu = 1;
-      bp.newton_iterations = nr.report.iterations;
-      if (opt.detect_hopf) internal::evaluate_spectrum(sys, bp, opt);
-    } catch (...) {
-      res.failed = true;
-      res.stop_reason = ctx + internal::current_exception_text();
-      if (opt.throw_on_failure) internal::rethrow_with_context(ctx);
       return res;
     }
-    w = bp.w;
-    res.points.push_back(std::move(bp));
+    const curve_corrected start = solve(w0, mu0);
+    start_iterations = start.iterations;
+    curve_stepper_options so = internal::continuation_stepper_options(opt, n, who);
+    so.predictor = curve_predictor::natural;
+    so.natural_index = n;
+    so.natural_direction = opt.ds > 0 ? 1 : -1;
+    so.step = std::abs(opt.ds);
+    const curve_outcome oc = trace_curve(prob, start.x, vec<double>(), curve_metric(vec<double>::Ones(n + 1)), so);
+    res.stop_reason = oc.stop == curve_stop::limit ? "left the mu interval" : "step limit";
+  } catch (...) {
+    res.failed = true;
+    res.stop_reason = context() + internal::current_exception_text();
+    if (opt.throw_on_failure) internal::rethrow_with_context(context());
   }
-  if (res.stop_reason.empty()) res.stop_reason = "step limit";
   return res;
 }
-
 /// Pseudo-arclength continuation from an equilibrium (w0, mu0) in the direction of increasing
-/// mu (direction = +1) or decreasing mu (-1).
+/// mu (direction = +1) or decreasing mu (-1): the curve stepper's tangent predictor with the
+/// bordered Newton corrector of the file comment; folds and Hopf points are detected and
+/// located on every accepted step.
 template <dynamical_system S>
 continuation_result pseudo_arclength_continuation(const S& sys, const vec<double>& w0, double mu0,
                                                   const continuation_options& opt = {}, int direction = +1) {
@@ -211,50 +252,35 @@ continuation_result pseudo_arclength_continuation(const S& sys, const vec<double
   check_continuation_options(opt, who, false);
   check_state(sys, w0, mu0, who);
   continuation_result res;
-  // Runs body; an exception from it ends the run (file comment): rethrown with ctx in front,
-  // or recorded in res (failed, stop_reason) and false returned.
-  auto guarded = [&](const std::string& ctx, auto&& body) -> bool {
-    try {
-      body();
-      return true;
-    } catch (...) {
-      res.failed = true;
-      res.stop_reason = internal::concat(who, ": ", ctx, ": ", internal::current_exception_text());
-      if (opt.verbose && opt.log) *opt.log << res.stop_reason << "\n";
-      if (opt.throw_on_failure) internal::rethrow_with_context(internal::concat(who, ": ", ctx, ": "));
-      return false;
-    }
-  };
-  int step = 0;
-  double ds = opt.ds;
   // Scaled variables: the w-part of the arclength is weighted by 1 / (sqrt(n) w_scale).
   const double ws = 1.0 / (std::sqrt(double(n)) * opt.w_scale);
-  auto dot = [&](const vec<double>& a, const vec<double>& b) {
-    return ws * ws * a.head(n).dot(b.head(n)) + a[n] * b[n];
-  };
+  vec<double> weight = vec<double>::Constant(n + 1, ws * ws);
+  weight[n] = 1;
+  const curve_metric metric(std::move(weight));
   direct_solver<M> lu("pseudo-arclength: bordered Jacobian");
-  auto bordered = [&](const vec<double>& x, const vec<double>& t) {
+  // [A f_mu; c^T] at x
+  auto bordered = [&](const vec<double>& x, const vec<double>& c) {
     block_assembler<M> j(n + 1, n + 1);
     j.add(0, 0, sys.jacobian(x.head(n), x[n]));
     j.add_column(0, n, residual_d_mu(sys, x.head(n), x[n]));
-    vec<double> row = t;
-    row.head(n) *= ws * ws;
-    j.add_row(n, 0, row);
+    j.add_row(n, 0, c);
     return j.build();
   };
-  auto tangent = [&](const vec<double>& x, const vec<double>& t_prev) {
-    lu.compute(bordered(x, t_prev));
+  // J t = e_last with the last row c (not normalised)
+  auto raw_tangent = [&](const vec<double>& x, const vec<double>& c) {
+    lu.compute(bordered(x, c));
     vec<double> rhs = vec<double>::Zero(n + 1);
     rhs[n] = 1;
-    vec<double> t = lu.solve(rhs);
-    return vec<double>(t / std::sqrt(dot(t, t)));
+    return vec<double>(lu.solve(rhs));
   };
-  // Corrector from the predicted point xp on the hyperplane t.(x - xp) = 0; nullopt on failure
-  // (counted, the reason kept in res.last_corrector_failure).
-  auto correct = [&](const vec<double>& xp, const vec<double>& t, int& iterations) -> std::optional<vec<double>> {
-    vec<double> x = xp;
+  int step = 0;  // the step being corrected (for the failure reasons)
+  double ds = opt.ds;
+  // Newton on [f(x); c.x - value] = 0 from x0; nullopt on failure (counted, the reason kept in
+  // res.last_corrector_failure).
+  auto correct = [&](const vec<double>& x0, const vec<double>& c, double value) -> std::optional<curve_corrected> {
+    vec<double> x = x0;
     double fn = NAN;
-    auto failed = [&](int it, const std::string& why) -> std::optional<vec<double>> {
+    auto failed = [&](int it, const std::string& why) -> std::optional<curve_corrected> {
       ++res.corrector_failures;
       res.last_corrector_failure = internal::concat(who, ": corrector of step ", step, " (ds = ", ds, ") at iteration ",
                                                     it, ", mu = ", x[n], ", ||f|| = ", fn, ": ", why);
@@ -264,157 +290,170 @@ continuation_result pseudo_arclength_continuation(const S& sys, const vec<double
       vec<double> f(n + 1);
       try {
         f.head(n) = sys.residual(vec<double>(x.head(n)), x[n]);
-        f[n] = dot(t, x - xp);
+        f[n] = c.dot(x) - value;
         for (Eigen::Index i = 0; i < f.size(); ++i)
           if (!std::isfinite(f[i])) return failed(it, internal::concat("residual entry ", i, " is not finite"));
         fn = f.head(n).norm();
-        lu.compute(bordered(x, t));
+        lu.compute(bordered(x, c));
         x -= lu.solve(f);
-        iterations = it;
         fn = vec<double>(sys.residual(vec<double>(x.head(n)), x[n])).norm();
       } catch (const error& e) {
         return failed(it, e.what());
       }
       if (!std::isfinite(fn)) return failed(it, "residual after the update is not finite");
-      if (fn <= opt.corrector_tolerance) return x;
+      if (fn <= opt.corrector_tolerance) return curve_corrected{x, it};
     }
     return failed(opt.corrector_iterations, "no convergence");
   };
-
-  vec<double> x(n + 1);
-  x.head(n) = w0;
-  x[n] = mu0;
-  vec<double> t;
-  auto push = [&](const vec<double>& xx, const vec<double>& tt, int iters) {
-    branch_point bp;
-    bp.w = xx.head(n);
-    bp.mu = xx[n];
-    bp.tangent_mu = tt[n];
-    bp.newton_iterations = iters;
-    if (opt.detect_hopf) internal::evaluate_spectrum(sys, bp, opt);
-    if (opt.verbose && opt.log)
-      *opt.log << "continuation " << std::setw(4) << res.points.size() << "  mu " << std::setprecision(10)
-               << bp.mu << "  dmu/ds " << std::setprecision(3) << bp.tangent_mu << "  gamma " << bp.gamma
-               << "  newton " << iters << std::setprecision(6) << "\n";
-    res.points.push_back(std::move(bp));
+  // on the hyperplane through xp orthogonal to t (in the metric)
+  auto correct_along = [&](const vec<double>& xp, const vec<double>& t) {
+    const vec<double> c = metric.row(t);
+    return correct(xp, c, c.dot(xp));
   };
-  if (!guarded(internal::concat("start at mu = ", mu0), [&] {
-        newton_options no;  // make sure the start is an equilibrium
-        no.abs_tolerance = opt.corrector_tolerance;
-        no.max_iterations = 2 * opt.corrector_iterations;
-        x.head(n) = newton(sys, w0, mu0, no).x;
-        vec<double> t0 = vec<double>::Zero(n + 1);
-        t0[n] = direction >= 0 ? 1.0 : -1.0;
-        t = tangent(x, t0);
-        push(x, t, 0);
-      }))
-    return res;
-  for (step = 1; step <= opt.max_steps; ++step) {
-    int iters = 0;
-    std::optional<vec<double>> xn;
-    while (!(xn = correct(x + ds * t, t, iters))) {
-      ds *= 0.5;
-      if (ds < opt.ds_min) {
-        res.stop_reason = internal::concat("step size below ds_min at mu = ", x[n], " (step ", step,
-                                           "; last corrector failure: ", res.last_corrector_failure, ")");
-        if (opt.verbose && opt.log) *opt.log << "continuation: " << res.stop_reason << "\n";
-        return res;
-      }
-    }
-    const vec<double> x_prev = x, t_prev = t;
-    if (!guarded(internal::concat("step ", step, ": tangent or spectrum at mu = ", (*xn)[n], " (from mu = ", x_prev[n],
-                                  ")"),
-                 [&] {
-                   const vec<double> tn = tangent(*xn, t);
-                   push(*xn, tn, iters);
-                   x = *xn;
-                   t = tn;
-                 }))
-      return res;
-    const int k = int(res.points.size()) - 2;  // index of the previous point
+  std::string context;  // what a failure ending the run was doing
+
+  // Fold where dmu/ds changes sign: secant iteration on t_mu over the arclength from the
+  // previous point along its tangent.
+  auto locate_fold = [&](const vec<double>& x_prev, const vec<double>& t_prev, const vec<double>& x, double s1, int k) {
     const branch_point& a = res.points[k];
     const branch_point& b = res.points[k + 1];
-    // ---- fold: sign change of dmu/ds; secant on t_mu over the step length from x_prev ----
-    if (opt.detect_folds && a.tangent_mu * b.tangent_mu < 0) {
-      detected_bifurcation fold{bifurcation_kind::fold, b.mu, b.w, 0, {}, k, 0};
-      if (opt.locate) {
-        double s0 = 0, f0 = a.tangent_mu, s1 = ds, f1 = b.tangent_mu;
-        vec<double> best = x;
-        for (int it = 1; it <= 30 && std::abs(f1) > 1e-10; ++it) {
-          const double s2 = s1 - f1 * (s1 - s0) / (f1 - f0);
-          int ci = 0;
-          auto xs = correct(x_prev + s2 * t_prev, t_prev, ci);
-          if (!xs) break;
-          vec<double> ts;
-          try {
-            ts = tangent(*xs, t_prev);
-          } catch (const error&) {  // a singular bordered matrix: keep the best point so far
-            break;
-          }
-          s0 = s1, f0 = f1, s1 = s2, f1 = ts[n];
-          best = *xs;
-          fold.locate_iterations = it;
-        }
-        fold.mu = best[n];
-        fold.w = best.head(n);
-      }
-      if (opt.verbose && opt.log)
-        *opt.log << "continuation: fold at mu = " << std::setprecision(12) << fold.mu << std::setprecision(6) << "\n";
-      res.bifurcations.push_back(std::move(fold));
-    }
-    // ---- Hopf: sign change of gamma ----
-    if (opt.detect_hopf && std::isfinite(a.gamma) && std::isfinite(b.gamma) && a.gamma * b.gamma < 0) {
-      const double th = a.gamma / (a.gamma - b.gamma);
-      detected_bifurcation hb{bifurcation_kind::hopf, (1 - th) * a.mu + th * b.mu,
-                              (1 - th) * a.w + th * b.w,
-                              std::abs((1 - th) * a.critical.imag() + th * b.critical.imag()), {}, k, 0};
-      if (opt.locate) {
-        // Equilibrium near the crossing (on the branch), then the augmented Newton iteration.
-        int ci = 0;
-        const double len = std::sqrt(dot(x - x_prev, x - x_prev));
-        auto xs = correct(x_prev + th * len * t_prev, t_prev, ci);
-        const vec<double> wg = xs ? vec<double>(xs->head(n)) : hb.w;
-        const double mug = xs ? (*xs)[n] : hb.mu;
+    detected_bifurcation fold{bifurcation_kind::fold, b.mu, b.w, 0, {}, k, 0};
+    if (opt.locate) {
+      double s0 = 0, f0 = a.tangent_mu, f1 = b.tangent_mu;
+      vec<double> best = x;
+      for (int it = 1; it <= 30 && std::abs(f1) > 1e-10; ++it) {
+        const double s2 = s1 - f1 * (s1 - s0) / (f1 - f0);
+        auto xs = correct_along(x_prev + s2 * t_prev, t_prev);
+        if (!xs) break;
+        vec<double> ts;
         try {
-          hopf_point guess = hopf_start(sys, wg, mug, hb.omega);
-          const hopf_result hr = solve_hopf(sys, guess, opt.hopf);
-          if (!hr.report.converged) throw convergence_error(hr.report.reason);  // hopf.throw_on_failure = false
-          hb.mu = hr.point.mu;
-          hb.w = hr.point.w;
-          hb.omega = hr.point.omega;
-          hb.p = hr.point.p;
-          hb.locate_iterations = hr.report.iterations;
-        } catch (const error& e) {  // no convergence, a singular pivot: not located
-          hb.mu = 1e300;  // not located: treated as spurious below
-          if (opt.verbose && opt.log) *opt.log << "continuation: Hopf location failed: " << e.what() << "\n";
+          ts = raw_tangent(xs->x, metric.row(t_prev));
+        } catch (const error&) {  // a singular bordered matrix: keep the best point so far
+          break;
         }
+        s0 = s1, f0 = f1, s1 = s2, f1 = ts[n] / metric.norm(ts);
+        best = xs->x;
+        fold.locate_iterations = it;
       }
-      // A jump of gamma between two different complex pairs (e.g. a pair born from two real
-      // eigenvalues near a fold) is not a Hopf crossing: keep only points located inside the
-      // bracket (with a margin of one step) that were not found already.
-      const double lo = std::min(a.mu, b.mu) - std::abs(b.mu - a.mu), hi = std::max(a.mu, b.mu) + std::abs(b.mu - a.mu);
-      bool spurious = opt.locate && (hb.mu < lo || hb.mu > hi);
-      for (const auto& other : res.bifurcations)
-        if (other.kind == bifurcation_kind::hopf && std::abs(other.mu - hb.mu) < 1e-8 * (1 + std::abs(hb.mu)))
-          spurious = true;
-      if (spurious) {
-        if (opt.verbose && opt.log)
-          *opt.log << "continuation: gamma changed sign between mu = " << a.mu << " and " << b.mu
-                   << " without a new Hopf crossing there (discarded)\n";
-      } else {
+      fold.mu = best[n];
+      fold.w = best.head(n);
+    }
+    if (opt.verbose && opt.log)
+      *opt.log << "continuation: fold at mu = " << std::setprecision(12) << fold.mu << std::setprecision(6) << "\n";
+    res.bifurcations.push_back(std::move(fold));
+  };
+  // Hopf point where gamma changes sign: Newton on the augmented system (hopf_problem,
+  // hopf_newton) from the branch point at the interpolated crossing.
+  auto locate_hopf = [&](const vec<double>& x_prev, const vec<double>& t_prev, const vec<double>& x, int k) {
+    const branch_point& a = res.points[k];
+    const branch_point& b = res.points[k + 1];
+    const double th = a.gamma / (a.gamma - b.gamma);
+    detected_bifurcation hb{bifurcation_kind::hopf, (1 - th) * a.mu + th * b.mu, (1 - th) * a.w + th * b.w,
+                            std::abs((1 - th) * a.critical.imag() + th * b.critical.imag()), {}, k, 0};
+    if (opt.locate) {
+      auto xs = correct_along(vec<double>(x_prev + th * metric.distance(x, x_prev) * t_prev), t_prev);
+      const vec<double> wg = xs ? vec<double>(xs->x.head(n)) : hb.w;
+      const double mug = xs ? xs->x[n] : hb.mu;
+      try {
+        const hopf_problem<S> prob(sys, hopf_start(sys, wg, mug, hb.omega), opt.hopf, "solve_hopf");
+        hopf_augmented_lu<S> strategy(opt.hopf);
+        const hopf_result hr = hopf_newton(prob, strategy, opt.hopf);
+        if (!hr.report.converged) throw convergence_error(hr.report.reason);  // hopf.throw_on_failure = false
+        hb.mu = hr.point.mu;
+        hb.w = hr.point.w;
+        hb.omega = hr.point.omega;
+        hb.p = hr.point.p;
+        hb.locate_iterations = hr.report.iterations;
+      } catch (const error& e) {  // no convergence, a singular pivot: not located
+        hb.mu = 1e300;            // treated as spurious below
+        if (opt.verbose && opt.log) *opt.log << "continuation: Hopf location failed: " << e.what() << "\n";
+      }
+    }
+    // A jump of gamma between two different complex pairs (e.g. a pair born from two real
+    // eigenvalues near a fold) is not a Hopf crossing: keep only points located inside the
+    // bracket (with a margin of one step) that were not found already.
+    const double lo = std::min(a.mu, b.mu) - std::abs(b.mu - a.mu), hi = std::max(a.mu, b.mu) + std::abs(b.mu - a.mu);
+    bool spurious = opt.locate && (hb.mu < lo || hb.mu > hi);
+    for (const auto& other : res.bifurcations)
+      if (other.kind == bifurcation_kind::hopf && std::abs(other.mu - hb.mu) < 1e-8 * (1 + std::abs(hb.mu)))
+        spurious = true;
+    if (spurious) {
       if (opt.verbose && opt.log)
-        *opt.log << "continuation: Hopf point at mu = " << std::setprecision(12) << hb.mu << ", omega = " << hb.omega
-                 << std::setprecision(6) << "\n";
-      res.bifurcations.push_back(std::move(hb));
-      }
+        *opt.log << "continuation: gamma changed sign between mu = " << a.mu << " and " << b.mu
+                 << " without a new Hopf crossing there (discarded)\n";
+      return;
     }
-    if (x[n] < opt.mu_min || x[n] > opt.mu_max) {
-      res.stop_reason = "left the mu interval";
-      return res;
+    if (opt.verbose && opt.log)
+      *opt.log << "continuation: Hopf point at mu = " << std::setprecision(12) << hb.mu << ", omega = " << hb.omega
+               << std::setprecision(6) << "\n";
+    res.bifurcations.push_back(std::move(hb));
+  };
+
+  curve_problem prob{
+      [&](const curve_request& q, std::string& why) {
+        step = q.point;
+        ds = q.step;
+        auto r = correct(q.x0, q.c, q.value);
+        if (!r) why = res.last_corrector_failure;
+        return r;
+      },
+      [&](const vec<double>& x, const vec<double>& c) {
+        if (!res.points.empty())
+          context = internal::concat("step ", res.points.size(), ": tangent or spectrum at mu = ", x[n],
+                                     " (from mu = ", res.points.back().mu, ")");
+        return raw_tangent(x, c);
+      },
+      [&](const vec<double>& x, const curve_point_info& info) {
+        branch_point bp;
+        bp.w = x.head(n);
+        bp.mu = x[n];
+        bp.tangent_mu = (*info.tangent)[n];
+        bp.newton_iterations = info.iterations;
+        if (opt.detect_hopf) internal::evaluate_spectrum(sys, bp, opt);
+        if (opt.verbose && opt.log)
+          *opt.log << "continuation " << std::setw(4) << res.points.size() << "  mu " << std::setprecision(10) << bp.mu
+                   << "  dmu/ds " << std::setprecision(3) << bp.tangent_mu << "  gamma " << bp.gamma << "  newton "
+                   << info.iterations << std::setprecision(6) << "\n";
+        res.points.push_back(std::move(bp));
+        if (info.start) return false;
+        const int k = int(res.points.size()) - 2;  // the previous point
+        const branch_point& a = res.points[k];
+        const branch_point& b = res.points[k + 1];
+        if (opt.detect_folds && a.tangent_mu * b.tangent_mu < 0) locate_fold(*info.from, *info.direction, x, info.step, k);
+        if (opt.detect_hopf && std::isfinite(a.gamma) && std::isfinite(b.gamma) && a.gamma * b.gamma < 0)
+          locate_hopf(*info.from, *info.direction, x, k);
+        return false;
+      }};
+
+  try {
+    context = internal::concat("start at mu = ", mu0);
+    newton_options no;  // make sure the start is an equilibrium
+    no.abs_tolerance = opt.corrector_tolerance;
+    no.max_iterations = 2 * opt.corrector_iterations;
+    vec<double> x(n + 1);
+    x.head(n) = newton(sys, w0, mu0, no).x;
+    x[n] = mu0;
+    const vec<double> e_mu = vec<double>::Unit(n + 1, n);
+    const vec<double> t = curve_unit_tangent(prob, metric, x, e_mu, vec<double>(direction >= 0 ? e_mu : -e_mu), who);
+    curve_stepper_options so = internal::continuation_stepper_options(opt, n, who);
+    so.predictor = curve_predictor::tangent;
+    so.step = opt.ds;
+    so.min_step = std::min(opt.ds_min, opt.ds);
+    so.max_step = opt.ds_max;
+    const curve_outcome oc = trace_curve(prob, x, t, metric, so);
+    if (oc.stop == curve_stop::step_underflow) {
+      res.stop_reason = internal::concat("step size below ds_min at mu = ", res.points.back().mu, " (step ",
+                                         res.points.size(), "; last corrector failure: ", res.last_corrector_failure, ")");
+      if (opt.verbose && opt.log) *opt.log << "continuation: " << res.stop_reason << "\n";
+    } else {
+      res.stop_reason = oc.stop == curve_stop::limit ? "left the mu interval" : "step limit";
     }
-    if (iters <= 3) ds = std::min(opt.ds_max, 1.5 * ds);
+  } catch (...) {
+    res.failed = true;
+    res.stop_reason = internal::concat(who, ": ", context, ": ", internal::current_exception_text());
+    if (opt.verbose && opt.log) *opt.log << res.stop_reason << "\n";
+    if (opt.throw_on_failure) internal::rethrow_with_context(internal::concat(who, ": ", context, ": "));
   }
-  res.stop_reason = "step limit";
   return res;
 }
 

@@ -43,28 +43,30 @@
 // point. The previous point's p is re-scaled to the new s (p <- i p / (s.p)) before the secant,
 // so the secant of p compares like with like.
 //
-// Predictor: first step along the tangent dX/dnu from J_G with the last row e_nu (needs
+// Stepping (curve_stepper.hpp, shared with the fixed-equilibrium tracer and the equilibrium
+// continuation): first step along the tangent dX/dnu from J_G with the last row e_nu (needs
 // dnu/ds != 0 at the start: start away from a turning point in nu), oriented by `direction`;
-// then the secant X_k - X_{k-1} scaled to unit length in the metric; after a failed corrector
-// the exact tangent at X_k (J_G t = e_last with the secant as last row) replaces the secant
-// (the chord points off the curve at every step size where the curve bends sharply: measured
-// on the heavy-case aerofoil near M = 0.84, where the secant stalled the trace). Corrector: newton_iterate
-// on G. Step control: halve on corrector failure (non-convergence, divergence, singular
-// matrix, NaN, any aerohopf::error thrown by family(nu) or the system, a corrector that moved
-// farther than corrector_distance x the step from the prediction, or one that landed behind the
-// last point or more than acos(min_cosine) off the predicted direction: both are jumps to another
-// sheet where the curve folds, measured on the heavy-case aerofoil near M = 0.84), grow by
-// `growth` after <= fast_iterations Newton iterations, clamp to [min_step, max_step]; below
-// min_step: convergence_error naming the last converged point, the attempted step and the last
-// failure (or, with throw_on_failure = false, stop with step_failure keeping the points). The
-// observer sees every point as it is accepted (write expensive curves out as they come).
+// then the secant, with the exact tangent at X_k (J_G t = e_last, the secant as last row) for
+// the retry after a failed corrector (where the curve bends sharply the chord points off the
+// curve at every step size: measured on the heavy-case aerofoil near M = 0.84). Step control:
+// halve on a failed corrector (non-convergence, divergence, singular matrix, NaN, any
+// aerohopf::error thrown by family(nu) or the system) or a sheet jump (a corrector farther
+// than corrector_distance x the step from the prediction, behind the last point, or more than
+// acos(min_cosine) off the predicted direction), grow by `growth` after <= fast_iterations
+// Newton iterations, clamp to [min_step, max_step]; below min_step: convergence_error naming
+// the last converged point, the attempted step and the last failure (or, with
+// throw_on_failure = false, stop with step_failure keeping the points). This file holds the
+// corrector (Newton on G by LU) and run_hopf_curve, the part both tracers share: the metric,
+// landings, the Bogdanov-Takens end, emission and failure policy. The observer sees every
+// point as it is accepted (write expensive curves out as they come).
 //
 // Stops: max_points; leaving [nu_min, nu_max] or [mu_min, mu_max] (the crossing is landed on
 // the bound exactly: Newton with the last row nu - bound = 0); omega <= omega_min or a sign
 // change of omega (Bogdanov-Takens: estimate of its (mu, nu) by extrapolating the last points
 // in omega^2, along which (mu, nu) are smooth); the curve closing on its start; stop_after
-// returning true for an accepted point (hopf_curve_stop::requested). nu_targets:
-// every crossing of a listed nu is landed exactly (a flutter boundary at given Mach numbers).
+// returning true for an accepted point (hopf_curve_stop::requested). nu_targets (strictly
+// monotone): every crossing of a listed nu is landed exactly (a flutter boundary at given Mach
+// numbers).
 //
 // Post-checks (those of hopf.hpp, for every accepted point): a converged corrector's
 // ||f(w, mu; nu)|| is at most the ||G|| its Newton run resolved (f is a block of G; confirmed,
@@ -80,6 +82,7 @@
 #include <Eigen/Core>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <complex>
@@ -98,6 +101,7 @@
 #include "../linalg/direct.hpp"
 #include "../nonlinear/newton.hpp"
 #include "../nonlinear/system.hpp"
+#include "curve_stepper.hpp"
 #include "hopf.hpp"
 #include "hopf_point.hpp"
 
@@ -241,124 +245,380 @@ class family_cache {
   std::optional<S> sys_;
   double nu_ = NAN;
 };
-}  // namespace internal
 
-/// Traces the Hopf curve of family(nu) through the Hopf point `start` of family(nu0) (a guess:
-/// it is first converged by solve_hopf at fixed nu0), initially in the direction of increasing
-/// (direction = +1) or decreasing (-1) nu. See the file comment.
-template <system_family F>
-hopf_curve_result trace_hopf_curve(const F& family, double nu0, const hopf_point& start,
-                                   const hopf_curve_options& opt = {}, int direction = +1) {
-  using S = family_system_t<F>;
-  using M = jacobian_t<S>;
+/// What a Hopf-curve corrector returns: the point, its iterations, and the smallest |omega| its
+/// Newton run resolves (hopf.hpp: 10 ||G|| / ||p||; below it omega is indistinguishable from 0).
+struct hopf_corrected : curve_corrected {
+  double omega_floor = 0;
+};
+
+/// The unknowns of a Hopf-curve tracer, X = [w (full system only), p_r, p_i, mu, nu, omega], the
+/// metric on (mu, nu, omega) and the normalisation of p.
+struct hopf_curve_layout {
   using C = std::complex<double>;
-  using clock = std::chrono::steady_clock;
-  const std::string& lab = opt.label;
-  const auto t_begin = clock::now();
-  require(std::isfinite(nu0), lab, ": nu0 is not finite");
-  internal::check_curve_options(opt, lab);
-  require(nu0 >= opt.nu_min && nu0 <= opt.nu_max, lab, ": nu0 = ", nu0, " outside [nu_min, nu_max]");
-  require(direction == 1 || direction == -1, lab, ": direction must be +1 or -1");
-  require(!opt.start.fixed_equilibrium, lab, ": the fixed-equilibrium Hopf system is not supported (w depends on nu)");
+  Eigen::Index n = 0, ipr = 0, ipi = 0, imu = 0, inu = 0, iom = 0, N = 0;
+  double sig[3] = {1, 1, 1};  ///< sigma_mu, sigma_nu, sigma_omega (0: not in the metric)
+  hopf_normalisation mode = hopf_normalisation::automatic;
 
-  hopf_curve_result res;
-  // ---- converge the start at fixed nu0 ----
-  const auto t_start = clock::now();
-  hopf_result h0;
-  Eigen::Index n = 0;
-  {
-    const S sys0 = family(nu0);
-    n = sys0.size();
-    require(n > 0, lab, ": family(nu0) has no unknowns");
-    require_size(start.w.size(), n, lab, "start.w (equilibrium at nu0)");
-    require_size(start.p.size(), n, lab, "start.p (eigenvector)");
-    require_finite(start.w, lab, "start.w (equilibrium at nu0)");
-    require_finite(start.p, lab, "start.p (eigenvector)");
-    require(std::isfinite(start.mu) && std::isfinite(start.omega), lab, ": start mu or omega is not finite (",
-            start.mu, ", ", start.omega, ")");
-    hopf_options ho = opt.start;
-    ho.label = lab + ": start point at nu = " + internal::concat(nu0);
-    h0 = solve_hopf(sys0, start, ho);
-    require(h0.report.converged, lab, ": start point at nu = ", nu0, " did not converge (", h0.report.reason, ")");
-  }
-  require(h0.point.omega > opt.omega_min, lab, ": start point has omega = ", h0.point.omega,
-          " <= omega_min (not a Hopf point)");
-  const Eigen::Index N = 3 * n + 3, ipr = n, ipi = 2 * n, imu = 3 * n, inu = 3 * n + 1, iom = 3 * n + 2;
-  const hopf_normalisation mode = resolve_normalisation<M>(opt.normalisation);
-  const double sig[3] = {opt.mu_scale, opt.nu_scale, opt.omega_scale};
-  auto yv = [&](const vec<double>& x, int j) { return x[imu + j]; };
-  // scaled metric on y = (mu, nu, omega)
-  auto ydot = [&](const vec<double>& a, const vec<double>& b) {
-    double d = 0;
-    for (int j = 0; j < 3; ++j)
-      if (sig[j] > 0) d += yv(a, j) * yv(b, j) / (sig[j] * sig[j]);
-    return d;
-  };
-  auto ydist = [&](const vec<double>& a, const vec<double>& b) {
-    const vec<double> d = a - b;
-    return std::sqrt(ydot(d, d));
-  };
-  auto get_p = [&](const vec<double>& x) {
+  hopf_curve_layout(Eigen::Index n_, bool with_w, const hopf_curve_options& opt, hopf_normalisation m)
+      : n(n_), ipr(with_w ? n_ : 0), ipi(ipr + n_), imu(ipi + n_), inu(imu + 1), iom(imu + 2), N(imu + 3),
+        sig{opt.mu_scale, opt.nu_scale, opt.omega_scale}, mode(m) {}
+
+  vec<C> get_p(const vec<double>& x) const {
     vec<C> p(n);
     p.real() = x.segment(ipr, n);
     p.imag() = x.segment(ipi, n);
     return p;
-  };
-  auto set_p = [&](vec<double>& x, const vec<C>& p) {
+  }
+  void set_p(vec<double>& x, const vec<C>& p) const {
     x.segment(ipr, n) = p.real();
     x.segment(ipi, n) = p.imag();
-  };
-  // p <- i p / (s.p): s.p_r = 0, s.p_i = 1 for a given s
-  auto rescale_p = [&](vec<double>& x, const vec<double>& s) {
+  }
+  /// p <- i p / (s.p): s.p_r = 0, s.p_i = 1 for the given s (so secants compare like with like)
+  void rescale_p(vec<double>& x, const vec<double>& s, const std::string& label) const {
     vec<C> p = get_p(x);
     const C sp = s.template cast<C>().dot(p);
-    require(std::abs(sp) > 0, lab, ": eigenvector orthogonal to the normalisation vector");
+    require(std::abs(sp) > 0, label, ": eigenvector orthogonal to the normalisation vector");
     p *= C(0, 1) / sp;
     set_p(x, p);
-  };
-  auto refresh_s = [&](vec<double>& x) {
+  }
+  /// A new s for the p of x (hopf_normalise), p of x rotated and scaled to it.
+  vec<double> refresh_s(vec<double>& x) const {
     vec<C> p = get_p(x);
     vec<double> s = hopf_normalise(p, mode);
     set_p(x, p);
     return s;
-  };
-
-  internal::family_cache<F, S> cur(family), plus(family), minus(family);
-  auto nu_h = [&](double nu) { return opt.nu_step > 0 ? opt.nu_step : std::cbrt(Eigen::NumTraits<double>::epsilon()) * std::max(1.0, std::abs(nu)); };
-  auto check_size = [&](const S& s, double nu) {
-    require(s.size() == n, lab, ": family(", nu, ") has ", s.size(), " unknowns, family(nu0) ", n);
-  };
-
-  // G(X) with the last row c.(y) - value
-  auto residual = [&](const vec<double>& x, const vec<double>& s, const double* c, double value) {
+  }
+  /// |dy|^2 = sum_j (dy_j / sigma_j)^2 over y = (mu, nu, omega), sigma_j = 0 left out.
+  curve_metric metric() const {
+    vec<double> w = vec<double>::Zero(N);
+    for (int j = 0; j < 3; ++j)
+      if (sig[j] > 0) w[imu + j] = 1 / (sig[j] * sig[j]);
+    return curve_metric(std::move(w));
+  }
+  /// The (mu, nu, omega) entries of a constraint row (the only ones a tracer's row has).
+  std::array<double, 3> row3(const vec<double>& c) const { return {c[imu], c[inu], c[iom]}; }
+  std::string describe(const vec<double>& x) const {
+    return concat("nu = ", x[inu], ", mu = ", x[imu], ", omega = ", x[iom]);
+  }
+  /// The rows of G after the flow: A p_r + omega p_i, A p_i - omega p_r (exact matrix-free
+  /// products at the flow state w), s.p_r, s.p_i - 1 and the constraint c.y - value.
+  template <class S>
+  void eigen_rows(const S& sys, const vec<double>& w, const vec<double>& x, const vec<double>& s,
+                  const std::array<double, 3>& c, double value, vec<double>& f) const {
     const double mu = x[imu], nu = x[inu], om = x[iom];
-    const S& sys = cur.at(nu);
-    check_size(sys, nu);
-    const vec<double> w = x.head(n), pr = x.segment(ipr, n), pi = x.segment(ipi, n);
-    vec<double> f(N);
-    f.head(n) = sys.residual(w, mu);
+    const vec<double> pr = x.segment(ipr, n), pi = x.segment(ipi, n);
     f.segment(ipr, n) = jacobian_product(sys, w, mu, pr) + om * pi;
     f.segment(ipi, n) = jacobian_product(sys, w, mu, pi) - om * pr;
     f[imu] = s.dot(pr);
     f[inu] = s.dot(pi) - 1.0;
     f[iom] = c[0] * mu + c[1] * nu + c[2] * om - value;
-    return f;
+  }
+};
+
+/// The input checks both tracers make first (input_error naming what is wrong).
+inline void check_curve_trace(const hopf_curve_options& opt, double nu0, int direction) {
+  const std::string& lab = opt.label;
+  require(std::isfinite(nu0), lab, ": nu0 is not finite");
+  check_curve_options(opt, lab);
+  require(nu0 >= opt.nu_min && nu0 <= opt.nu_max, lab, ": nu0 = ", nu0, " outside [nu_min, nu_max]");
+  require(direction == 1 || direction == -1, lab, ": direction must be +1 or -1");
+}
+
+/// A start of n unknowns (w, p finite and of that size; mu, omega finite).
+inline void check_curve_start(const hopf_point& start, Eigen::Index n, const std::string& lab) {
+  require(n > 0, lab, ": family(nu0) has no unknowns");
+  require_size(start.w.size(), n, lab, "start.w (equilibrium at nu0)");
+  require_size(start.p.size(), n, lab, "start.p (eigenvector)");
+  require_finite(start.w, lab, "start.w (equilibrium at nu0)");
+  require_finite(start.p, lab, "start.p (eigenvector)");
+  require(std::isfinite(start.mu) && std::isfinite(start.omega), lab, ": start mu or omega is not finite (", start.mu,
+          ", ", start.omega, ")");
+}
+
+/// The stepper options of a Hopf-curve tracer: step control, sheet-jump guard, landings on
+/// nu_targets and on the finite bounds of nu and mu (in that order), closed-curve detection.
+inline curve_stepper_options hopf_curve_stepper_options(const hopf_curve_options& opt, const hopf_curve_layout& L) {
+  curve_stepper_options so;
+  so.step = opt.step, so.min_step = opt.min_step, so.max_step = opt.max_step;
+  so.growth = opt.growth, so.fast_iterations = opt.fast_iterations, so.max_points = opt.max_points;
+  so.predictor = curve_predictor::secant;
+  so.retry_exact_tangent = true;
+  so.sheet_guard = true;
+  so.corrector_distance = opt.corrector_distance;
+  so.min_cosine = opt.min_cosine;
+  so.detect_closed = opt.detect_closed;
+  so.kink_primary = L.inu;  // the kinks of a C1 family lie on lines nu = const (hopf_curve_fixed_equilibrium.hpp)
+  so.kink_secondary = L.imu;
+  so.kink_primary_name = "nu";
+  so.kink_secondary_name = "mu";
+  if (!opt.nu_targets.empty()) so.targets.push_back({L.inu, opt.nu_targets, "nu"});
+  if (std::isfinite(opt.nu_min)) so.bounds.push_back({L.inu, opt.nu_min, "nu"});
+  if (std::isfinite(opt.nu_max)) so.bounds.push_back({L.inu, opt.nu_max, "nu"});
+  if (std::isfinite(opt.mu_min)) so.bounds.push_back({L.imu, opt.mu_min, "mu"});
+  if (std::isfinite(opt.mu_max)) so.bounds.push_back({L.imu, opt.mu_max, "mu"});
+  so.label = opt.label;
+  so.verbose = opt.verbose;
+  so.log = opt.log;
+  return so;
+}
+
+/// Traces a Hopf curve with the corrector `corr` through the converged start x (p not yet
+/// normalised) on the curve stepper: the first tangent dX/dnu oriented by direction, the
+/// emission of hopf_curve_points into res (observer, stop_after), the Bogdanov-Takens end
+/// (omega at or below max(omega_min, the resolved frequency), or of the wrong sign: its (mu, nu)
+/// by least squares in omega^2 over the last three points, along which they are smooth),
+/// landed points refused below the resolved frequency, and the failure policy of the file
+/// comment. The corrector provides
+///   std::optional<hopf_corrected> correct(const curve_request&, const vec<double>& s, std::string& why)
+///   vec<double> tangent(x, s, c)          J t = e_last with the last row c (not normalised)
+///   vec<double> point_w(x)                the equilibrium of the point
+///   void step_corrected(); void before_emit(bool landed); std::string costs_text();
+///   void after_emit(const hopf_curve_point&)    (cost accounting per emitted point)
+template <class Corrector, class Result>
+Result run_hopf_curve(Corrector& corr, const hopf_curve_layout& L, vec<double> x, int start_iterations,
+                      double start_seconds, const hopf_curve_options& opt, int direction, Result& res,
+                      std::chrono::steady_clock::time_point t_begin, const curve_stepper_options& so) {
+  const std::string& lab = opt.label;
+  const curve_metric metric = L.metric();
+  vec<double> s = L.refresh_s(x);
+  auto finish = [&](hopf_curve_stop why, std::string reason) {
+    res.stop = why;
+    res.stop_reason = std::move(reason);
+    res.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_begin).count();
+    if (opt.verbose && opt.log) *opt.log << lab << ": stop: " << res.stop_reason << std::endl;
+    return std::move(res);
   };
-  auto jacobian = [&](const vec<double>& x, const vec<double>& s, const double* c) {
+  struct problem {
+    Corrector& corr;
+    const hopf_curve_layout& L;
+    const hopf_curve_options& opt;
+    Result& res;
+    vec<double>& s;
+    int start_iterations;
+    double start_seconds;
+
+    std::optional<hopf_corrected> correct(const curve_request& q, std::string& why) {
+      std::optional<hopf_corrected> r = corr.correct(q, s, why);
+      if (r && q.kind == curve_attempt::landing && !(r->x[L.iom] > r->omega_floor)) {
+        why = concat("the landed point has omega = ", r->x[L.iom], ", not above the resolved frequency ",
+                     r->omega_floor);
+        r.reset();
+      }
+      return r;
+    }
+    vec<double> tangent(const vec<double>& x, const vec<double>& c) { return corr.tangent(x, s, c); }
+    bool emit(const vec<double>& x, const curve_point_info& i) {
+      hopf_curve_point pt;
+      pt.w = corr.point_w(x);
+      pt.p = L.get_p(x);
+      pt.mu = x[L.imu];
+      pt.nu = x[L.inu];
+      pt.omega = x[L.iom];
+      pt.newton_iterations = i.start ? start_iterations : i.iterations;
+      pt.attempts = i.attempts;
+      pt.step = i.distance;
+      pt.seconds = i.start ? start_seconds : i.seconds;
+      pt.landed = i.landed;
+      corr.before_emit(pt.landed);
+      if (opt.verbose && opt.log)
+        *opt.log << opt.label << " " << std::setw(4) << res.points.size() << "  nu " << std::setprecision(10) << pt.nu
+                 << "  mu " << pt.mu << "  omega " << pt.omega << "  newton " << pt.newton_iterations
+                 << corr.costs_text() << "  step " << std::setprecision(4) << pt.step << "  " << std::setprecision(3)
+                 << pt.seconds << " s"
+                 << (pt.attempts > 1 ? "  (" + std::to_string(pt.attempts - 1) + " retries)" : "")
+                 << (pt.landed ? "  (landed)" : "") << std::setprecision(6) << std::endl;
+      if (opt.observer) opt.observer(pt);
+      corr.after_emit(pt);
+      const bool stop = opt.stop_after && opt.stop_after(pt);
+      res.points.push_back(std::move(pt));
+      return stop;
+    }
+    std::optional<curve_end> end_of_curve(const hopf_corrected& r, const vec<double>* before, const vec<double>& last,
+                                          const vec<double>& xnew) {
+      corr.step_corrected();
+      if (xnew[L.iom] > std::max(opt.omega_min, r.omega_floor)) return std::nullopt;
+      // least squares of y = a + b omega^2 over the last points
+      std::vector<const vec<double>*> pts = {&last, &xnew};
+      if (before) pts.push_back(before);
+      double s1 = 0, sz = 0, szz = 0, sy[2] = {0, 0}, szy[2] = {0, 0};
+      for (const vec<double>* q : pts) {
+        const double z = (*q)[L.iom] * (*q)[L.iom];
+        s1 += 1, sz += z, szz += z * z;
+        for (int j = 0; j < 2; ++j) sy[j] += (*q)[L.imu + j], szy[j] += z * (*q)[L.imu + j];
+      }
+      const double det = s1 * szz - sz * sz;
+      for (int j = 0; j < 2; ++j) {
+        const double a = std::abs(det) > 1e-300 ? (szz * sy[j] - sz * szy[j]) / det : xnew[L.imu + j];
+        (j == 0 ? res.bogdanov_takens_mu : res.bogdanov_takens_nu) = a;
+      }
+      return curve_end{xnew[L.iom] > r.omega_floor,  // a Hopf point with a resolved frequency
+                       concat("omega -> 0: the Hopf curve ends at a Bogdanov-Takens point near nu = ",
+                              res.bogdanov_takens_nu, ", mu = ", res.bogdanov_takens_mu, " (last omega ", xnew[L.iom],
+                              ")")};
+    }
+    void renormalise(vec<double>& xnew, vec<double>& last) {
+      s = L.refresh_s(xnew);
+      L.rescale_p(last, s, opt.label);
+    }
+    std::string describe(const vec<double>& x) const { return L.describe(x); }
+  } prob{corr, L, opt, res, s, start_iterations, start_seconds};
+
+  vec<double> t;
+  try {
+    const vec<double> e_nu = vec<double>::Unit(L.N, L.inu);
+    t = curve_unit_tangent(prob, metric, x, e_nu, vec<double>(direction * e_nu), lab);
+  } catch (const error& e) {
+    throw convergence_error(concat(lab, ": no tangent dX/dnu at the start (nu = ", x[L.inu], ", mu = ", x[L.imu],
+                                   "): a turning point of the curve in nu or a degenerate Hopf point? ", e.what()));
+  }
+  curve_outcome oc;
+  // An aerohopf::error escaping the stepper (a normalisation that breaks down, a family or a
+  // steady solve that throws outside a corrector) ends the trace like a step failure.
+  try {
+    trace_curve(prob, x, t, metric, so, oc);
+    if constexpr (requires { res.kink_steps; }) res.kink_steps = oc.kink_steps;
+    res.failed_correctors = oc.failed_correctors;
+    res.missed_targets = oc.missed;
+    switch (oc.stop) {
+      case curve_stop::max_points: return finish(hopf_curve_stop::max_points, "max_points reached");
+      case curve_stop::requested: return finish(hopf_curve_stop::requested, "stop requested by stop_after");
+      case curve_stop::bound:
+        return finish(oc.bound_index == L.inu ? hopf_curve_stop::nu_bounds : hopf_curve_stop::mu_bounds, oc.reason);
+      case curve_stop::end_of_curve: return finish(hopf_curve_stop::bogdanov_takens, oc.reason);
+      case curve_stop::closed_curve: return finish(hopf_curve_stop::closed_curve, oc.reason);
+      default: break;
+    }
+    const hopf_curve_point& lp = res.points.back();
+    std::string why = oc.reason;
+    if (opt.omega_scale == 0 && lp.omega < 1e-2) why += " (omega is small: a Bogdanov-Takens end? set omega_scale > 0)";
+    if (opt.throw_on_failure) throw convergence_error(why);
+    return finish(hopf_curve_stop::step_failure, why);
+  } catch (const error& e) {
+    if constexpr (requires { res.kink_steps; }) res.kink_steps = oc.kink_steps;
+    res.failed_correctors = oc.failed_correctors;
+    res.missed_targets = oc.missed;
+    const bool none = res.points.empty();
+    const std::string where =
+        curve_failure_context(lab, res.points.size(), none ? x[L.inu] : res.points.back().nu,
+                              none ? x[L.imu] : res.points.back().mu, none ? x[L.iom] : res.points.back().omega);
+    if (opt.throw_on_failure) rethrow_with_context(where, "");
+    return finish(hopf_curve_stop::step_failure, where + e.what());
+  }
+}
+
+/// What the correctors of both tracers share: the layout, the options, the nu step of the
+/// central differences, and family members checked for the size of family(nu0).
+template <system_family F>
+class hopf_curve_corrector_base {
+ public:
+  using S = family_system_t<F>;
+  using M = jacobian_t<S>;
+
+ protected:
+  hopf_curve_corrector_base(const hopf_curve_layout& L, const hopf_curve_options& opt) : L_(L), opt_(opt) {}
+  /// h of the nu differences: nu_step, or cbrt(eps) max(1, |nu|) (error O(h^2))
+  double nu_h(double nu) const {
+    return opt_.nu_step > 0 ? opt_.nu_step : std::cbrt(Eigen::NumTraits<double>::epsilon()) * std::max(1.0, std::abs(nu));
+  }
+  const S& system_at(family_cache<F, S>& cache, double nu) const {
+    const S& sys = cache.at(nu);
+    require(sys.size() == L_.n, opt_.label, ": family(", nu, ") has ", sys.size(), " unknowns, family(nu0) ", L_.n);
+    return sys;
+  }
+  const hopf_curve_layout& L_;
+  const hopf_curve_options& opt_;
+};
+
+/// The corrector of the full Hopf curve: Newton on G (file comment) with the sparse or dense LU
+/// of J_G, nu-derivatives by central differences of the family.
+template <system_family F>
+class hopf_curve_corrector : hopf_curve_corrector_base<F> {
+  using base = hopf_curve_corrector_base<F>;
+  using base::L_, base::opt_, base::nu_h, base::system_at;
+
+ public:
+  using typename base::S, typename base::M;
+
+  hopf_curve_corrector(const F& family, const hopf_curve_layout& L, const hopf_curve_options& opt)
+      : base(L, opt), cur_(family), plus_(family), minus_(family), lu_(opt.label + ": extended Hopf Jacobian") {}
+
+  /// Newton on G from q.x0 with the last row q.c.X = q.value. A converged point passes the
+  /// post-checks of hopf.hpp: f is the first block of G, so ||f(w, mu)|| <= the resolved ||G||
+  /// (confirmed, not assumed); the frequency floor goes with it to the caller.
+  std::optional<hopf_corrected> correct(const curve_request& q, const vec<double>& s, std::string& why) {
+    const auto c = L_.row3(q.c);
+    newton_options no = opt_.newton;
+    no.throw_on_failure = true;
+    hopf_iterate_log last(q.x0, L_.imu, L_.iom, L_.inu);
+    try {
+      newton_result nr = newton_iterate(
+          [&](const vec<double>& x) { return residual(x, s, c, q.value); },
+          [&](const vec<double>& x, const vec<double>& f, int k) {
+            last.record(x, f, k);
+            lu_.compute(jacobian(x, s, c));
+            return vec<double>(-lu_.solve(f));
+          },
+          q.x0, no, opt_.label + " corrector");
+      if (!nr.x.allFinite()) {
+        why = "corrector returned a non-finite point" + last.describe();
+        return std::nullopt;
+      }
+      const double r = hopf_resolved_residual(nr.report, no);
+      const vec<double>& xc = nr.x;
+      const double fn = hopf_norm(vec<double>(cur_.at(xc[L_.inu]).residual(vec<double>(xc.head(L_.n)), xc[L_.imu])));
+      const double floor = hopf_frequency_floor(r, xc.segment(L_.ipr, 2 * L_.n).norm());
+      const std::string bad = curve_equilibrium_check(fn, r, xc[L_.inu], xc[L_.imu], xc[L_.iom]);
+      if (!bad.empty()) {
+        why = bad;
+        return std::nullopt;
+      }
+      hopf_corrected out;
+      out.x = std::move(nr.x);
+      out.iterations = nr.report.iterations;
+      out.omega_floor = floor;
+      return out;
+    } catch (const error& e) {
+      why = e.what() + last.describe();
+      return std::nullopt;
+    }
+  }
+  /// J_G t = e_last with the last row c. Throws singular_matrix_error.
+  vec<double> tangent(const vec<double>& x, const vec<double>& s, const vec<double>& c) {
+    lu_.compute(jacobian(x, s, L_.row3(c)));
+    return lu_.solve(vec<double>(vec<double>::Unit(L_.N, L_.iom)));
+  }
+  vec<double> point_w(const vec<double>& x) const { return x.head(L_.n); }
+  void step_corrected() {}
+  void before_emit(bool) {}
+  std::string costs_text() const { return {}; }
+  void after_emit(const hopf_curve_point&) {}
+
+ private:
+  using row = std::array<double, 3>;
+  // G(X) with the last row c.y - value
+  vec<double> residual(const vec<double>& x, const vec<double>& s, const row& c, double value) {
+    const S& sys = system_at(cur_, x[L_.inu]);
+    const vec<double> w = x.head(L_.n);
+    vec<double> f(L_.N);
+    f.head(L_.n) = sys.residual(w, x[L_.imu]);
+    L_.eigen_rows(sys, w, x, s, c, value, f);
+    return f;
+  }
+  M jacobian(const vec<double>& x, const vec<double>& s, const row& c) {
+    const Eigen::Index n = L_.n, ipr = L_.ipr, ipi = L_.ipi, imu = L_.imu, inu = L_.inu, iom = L_.iom;
     const double mu = x[imu], nu = x[inu], om = x[iom];
     const vec<double> w = x.head(n), pr = x.segment(ipr, n), pi = x.segment(ipi, n);
     const double h = nu_h(nu);
-    const S& sp = plus.at(nu + h);
-    const S& sm = minus.at(nu - h);
-    check_size(sp, nu + h);
-    check_size(sm, nu - h);
+    const S& sp = system_at(plus_, nu + h);
+    const S& sm = system_at(minus_, nu - h);
     const vec<double> f_nu = (vec<double>(sp.residual(w, mu)) - vec<double>(sm.residual(w, mu))) / (2 * h);
     const vec<double> apr_nu = (jacobian_product(sp, w, mu, pr) - jacobian_product(sm, w, mu, pr)) / (2 * h);
     const vec<double> api_nu = (jacobian_product(sp, w, mu, pi) - jacobian_product(sm, w, mu, pi)) / (2 * h);
-    const S& sys = cur.at(nu);
+    const S& sys = system_at(cur_, nu);
     const M a = sys.jacobian(w, mu);
     const M amu = jacobian_d_mu(sys, w, mu);
-    block_assembler<M> j(N, N);
+    block_assembler<M> j(L_.N, L_.N);
     j.add(0, 0, a);
     j.add_column(0, imu, residual_d_mu(sys, w, mu));
     j.add_column(0, inu, f_nu);
@@ -378,295 +638,56 @@ hopf_curve_result trace_hopf_curve(const F& family, double nu0, const hopf_point
     j.add_row(inu, ipi, s);
     for (int k = 0; k < 3; ++k) j.add_entry(iom, imu + k, c[k]);
     return j.build();
-  };
-  direct_solver<M> lu(lab + ": extended Hopf Jacobian");
+  }
 
-  struct corrected {
-    vec<double> x;
-    int iterations = 0;
-    double omega_floor = 0;  ///< the smallest |omega| its Newton run resolves (hopf.hpp)
-  };
-  std::string last_failure;
-  // Newton on G from x0 with the last row c.y = value; nullopt (and last_failure, with the last
-  // accepted iterate) on failure. A converged point passes the post-checks of hopf.hpp: f is the
-  // first block of G, so ||f(w, mu)|| <= the resolved ||G|| (confirmed, not assumed), and omega
-  // must exceed the resolved frequency 10 ||G|| / ||p|| or it is a real eigenvalue (the caller
-  // treats it as the Bogdanov-Takens end, omega -> 0).
-  auto correct = [&](const vec<double>& x0, const vec<double>& s, const double* c,
-                     double value) -> std::optional<corrected> {
-    newton_options no = opt.newton;
-    no.throw_on_failure = true;
-    internal::hopf_iterate_log last(x0, imu, iom, inu);
-    try {
-      newton_result nr = newton_iterate(
-          [&](const vec<double>& x) { return residual(x, s, c, value); },
-          [&](const vec<double>& x, const vec<double>& f, int k) {
-            last.record(x, f, k);
-            lu.compute(jacobian(x, s, c));
-            return vec<double>(-lu.solve(f));
-          },
-          x0, no, lab + " corrector");
-      if (!nr.x.allFinite()) {
-        last_failure = "corrector returned a non-finite point" + last.describe();
-        return std::nullopt;
-      }
-      const double r = internal::hopf_resolved_residual(nr.report, no);
-      const vec<double>& xc = nr.x;
-      const double fn = internal::hopf_norm(vec<double>(cur.at(xc[inu]).residual(vec<double>(xc.head(n)), xc[imu])));
-      const double floor = internal::hopf_frequency_floor(r, xc.segment(ipr, 2 * n).norm());
-      const std::string why = internal::curve_equilibrium_check(fn, r, xc[inu], xc[imu], xc[iom]);
-      if (!why.empty()) {
-        last_failure = why;
-        return std::nullopt;
-      }
-      return corrected{std::move(nr.x), nr.report.iterations, floor};
-    } catch (const error& e) {
-      last_failure = e.what() + last.describe();
-      return std::nullopt;
-    }
-  };
+  family_cache<F, S> cur_, plus_, minus_;
+  direct_solver<M> lu_;
+};
+}  // namespace internal
 
-  auto make_point = [&](const vec<double>& x, int iters, int attempts, double step, double secs, bool landed) {
-    hopf_curve_point pt;
-    pt.w = x.head(n);
-    pt.p = get_p(x);
-    pt.mu = x[imu];
-    pt.nu = x[inu];
-    pt.omega = x[iom];
-    pt.newton_iterations = iters;
-    pt.attempts = attempts;
-    pt.step = step;
-    pt.seconds = secs;
-    pt.landed = landed;
-    return pt;
-  };
-  bool stop_requested = false;  // opt.stop_after said so for the last accepted point
-  auto emit = [&](hopf_curve_point pt) {
-    if (opt.verbose && opt.log)
-      *opt.log << lab << " " << std::setw(4) << res.points.size() << "  nu " << std::setprecision(10) << pt.nu
-               << "  mu " << pt.mu << "  omega " << pt.omega << "  newton " << pt.newton_iterations << "  step "
-               << std::setprecision(4) << pt.step << (pt.attempts > 1 ? "  (" + std::to_string(pt.attempts - 1) + " retries)" : "")
-               << (pt.landed ? "  (landed)" : "") << std::setprecision(6) << "\n";
-    if (opt.observer) opt.observer(pt);
-    stop_requested = opt.stop_after && opt.stop_after(pt);
-    res.points.push_back(std::move(pt));
-  };
-  auto finish = [&](hopf_curve_stop why, std::string reason) {
-    res.stop = why;
-    res.stop_reason = std::move(reason);
-    res.seconds = std::chrono::duration<double>(clock::now() - t_begin).count();
-    if (opt.verbose && opt.log) *opt.log << lab << ": stop: " << res.stop_reason << "\n";
-    return res;
-  };
-  auto seconds_since = [](clock::time_point t) { return std::chrono::duration<double>(clock::now() - t).count(); };
+/// Traces the Hopf curve of family(nu) through the Hopf point `start` of family(nu0) (a guess:
+/// it is first converged by solve_hopf at fixed nu0), initially in the direction of increasing
+/// (direction = +1) or decreasing (-1) nu. See the file comment.
+template <system_family F>
+hopf_curve_result trace_hopf_curve(const F& family, double nu0, const hopf_point& start,
+                                   const hopf_curve_options& opt = {}, int direction = +1) {
+  using S = family_system_t<F>;
+  using M = jacobian_t<S>;
+  using clock = std::chrono::steady_clock;
+  const std::string& lab = opt.label;
+  const auto t_begin = clock::now();
+  internal::check_curve_trace(opt, nu0, direction);
+  require(!opt.start.fixed_equilibrium, lab, ": the fixed-equilibrium Hopf system is not supported (w depends on nu)");
 
-  // ---- start point and first tangent dX/dnu ----
-  vec<double> x(N);
-  x.head(n) = h0.point.w;
-  set_p(x, h0.point.p);
-  x[imu] = h0.point.mu;
-  x[inu] = nu0;
-  x[iom] = h0.point.omega;
-  vec<double> s = refresh_s(x);
-  emit(make_point(x, h0.report.iterations, 1, 0.0, seconds_since(t_start), false));
-  // Exact tangent at x: J_G with the last row c (any direction not orthogonal to the curve),
-  // J_G t = e_last, normalised in the metric. Throws singular_matrix_error.
-  auto exact_tangent = [&](const vec<double>& xx, const vec<double>& ss, const double* c) {
-    lu.compute(jacobian(xx, ss, c));
-    vec<double> e = vec<double>::Zero(N);
-    e[iom] = 1;
-    vec<double> tt = lu.solve(e);
-    const double tn = std::sqrt(ydot(tt, tt));
-    if (!(std::isfinite(tn) && tn > 0)) throw singular_matrix_error(lab + ": tangent is not finite");
-    return vec<double>(tt / tn);
-  };
-  vec<double> t;
+  // ---- converge the start at fixed nu0 ----
+  const auto t_start = clock::now();
+  hopf_result h0;
+  Eigen::Index n = 0;
   {
-    const double c_nu[3] = {0, 1, 0};
-    try {
-      t = exact_tangent(x, s, c_nu);
-    } catch (const singular_matrix_error& e) {
-      throw convergence_error(internal::concat(lab, ": no tangent dX/dnu at the start (nu = ", nu0, ", mu = ", x[imu],
-                                               "): a turning point of the curve in nu or a degenerate Hopf point? ",
-                                               e.what()));
-    }
-    if (t[inu] * direction < 0) t = -t;
+    const S sys0 = family(nu0);
+    n = sys0.size();
+    internal::check_curve_start(start, n, lab);
+    hopf_options ho = opt.start;
+    ho.label = lab + ": start point at nu = " + internal::concat(nu0);
+    const hopf_problem<S> prob(sys0, start, ho, "solve_hopf");
+    hopf_augmented_lu<S> lu(ho);
+    h0 = hopf_newton(prob, lu, ho);
+    require(h0.report.converged, lab, ": start point at nu = ", nu0, " did not converge (", h0.report.reason, ")");
   }
-  if (res.points.size() >= size_t(opt.max_points)) return finish(hopf_curve_stop::max_points, "max_points reached");
-  if (stop_requested) return finish(hopf_curve_stop::requested, "stop requested by stop_after");
-
-  // nu/mu values whose crossing is landed exactly: (row, value, is_bound)
-  struct landing {
-    int row;  // 0: mu, 1: nu
-    double value;
-    bool bound;
-  };
-  std::vector<landing> lands;
-  for (double v : opt.nu_targets) lands.push_back({1, v, false});
-  if (std::isfinite(opt.nu_min)) lands.push_back({1, opt.nu_min, true});
-  if (std::isfinite(opt.nu_max)) lands.push_back({1, opt.nu_max, true});
-  if (std::isfinite(opt.mu_min)) lands.push_back({0, opt.mu_min, true});
-  if (std::isfinite(opt.mu_max)) lands.push_back({0, opt.mu_max, true});
-
-  const vec<double> x_first = x;
-  vec<double> x_prev;  // the point before x (for the Bogdanov-Takens extrapolation)
-  double ds = std::min(opt.step, opt.max_step), arclength = 0;
-  // An aerohopf::error escaping the step (a normalisation that breaks down, a family that throws
-  // outside a corrector) ends the trace like a step failure: rethrown with the last point's
-  // context (same type), or with throw_on_failure = false a step_failure stop keeping the points.
-  try {
-    for (;;) {
-      const auto t_point = clock::now();
-      int attempts = 0;
-      bool exact_t = false;  // t is the exact tangent at x (not the secant)
-      std::optional<corrected> xn;
-      for (;;) {
-        ++attempts;
-        const vec<double> xp = x + ds * t;
-        double c[3], value = 0;
-        for (int j = 0; j < 3; ++j) {
-          c[j] = sig[j] > 0 ? yv(t, j) / (sig[j] * sig[j]) : 0.0;
-          value += c[j] * yv(xp, j);
-        }
-        xn = correct(xp, s, c, value);
-        if (xn) {
-          // reject a corrector that wandered (another branch) or reversed the direction
-          const double moved = ydist(xn->x, xp);
-          const vec<double> d = xn->x - x;
-          const double dn = std::sqrt(ydot(d, d));
-          if (!(moved <= opt.corrector_distance * ds)) {
-            last_failure = internal::concat("corrector moved ", moved, " from the prediction (step ", ds, ")");
-            xn.reset();
-          } else if (!(ydot(d, t) > opt.min_cosine * dn)) {
-            // behind the last point, or far off the predicted direction: a jump to another
-            // sheet of a folded curve (measured on the heavy-case aerofoil near M = 0.84)
-            last_failure = "the corrected point lies behind the last point or off the predicted direction";
-            xn.reset();
-          }
-        }
-        if (xn) break;
-        ++res.failed_correctors;
-        // First failure at this point: the secant is the chord of the last step and, where the
-        // curve bends sharply, points off the curve at any step size. Retry the same step along
-        // the exact tangent at x (oriented along the secant), then halve.
-        bool retry_same = false;
-        if (!exact_t && res.points.size() > 1) {
-          try {
-            double c[3];
-            for (int j = 0; j < 3; ++j) c[j] = sig[j] > 0 ? yv(t, j) / (sig[j] * sig[j]) : 0.0;
-            vec<double> te = exact_tangent(x, s, c);
-            if (ydot(te, t) < 0) te = -te;
-            t = std::move(te);
-            retry_same = true;
-          } catch (const error& e) {
-            last_failure += internal::concat(" (exact tangent failed: ", e.what(), ")");
-          }
-          exact_t = true;
-        }
-        if (opt.verbose && opt.log)
-          *opt.log << lab << ": step " << ds << " from nu = " << x[inu] << ", mu = " << x[imu] << " failed ("
-                   << last_failure << "), " << (retry_same ? "retrying along the exact tangent" : "halving") << "\n";
-        if (retry_same) continue;
-        ds *= 0.5;
-        if (ds < opt.min_step) {
-          const std::string why = internal::concat(
-              lab, ": step fell below min_step = ", opt.min_step, " after the point nu = ", x[inu], ", mu = ", x[imu],
-              ", omega = ", x[iom], " (point ", res.points.size() - 1, "); last attempted step ", 2 * ds,
-              ", last failure: ", last_failure,
-              opt.omega_scale == 0 && x[iom] < 1e-2 ? " (omega is small: a Bogdanov-Takens end? set omega_scale > 0)" : "");
-          if (opt.throw_on_failure) throw convergence_error(why);
-          return finish(hopf_curve_stop::step_failure, why);
-        }
-      }
-      vec<double> xnew = std::move(xn->x);
-      const int iters = xn->iterations;
-
-      // ---- Bogdanov-Takens: omega reaches zero (or below what the corrector resolves) or changes sign ----
-      const double omega_floor = xn->omega_floor;
-      if (xnew[iom] <= std::max(opt.omega_min, omega_floor)) {
-        // (mu, nu) are smooth in omega^2 along the curve: least squares of y = a + b omega^2
-        std::vector<const vec<double>*> pts = {&x, &xnew};
-        if (x_prev.size()) pts.push_back(&x_prev);
-        double s1 = 0, sz = 0, szz = 0;
-        double sy[2] = {0, 0}, szy[2] = {0, 0};
-        for (const vec<double>* q : pts) {
-          const double z = (*q)[iom] * (*q)[iom];
-          s1 += 1, sz += z, szz += z * z;
-          for (int j = 0; j < 2; ++j) sy[j] += (*q)[imu + j], szy[j] += z * (*q)[imu + j];
-        }
-        const double det = s1 * szz - sz * sz;
-        for (int j = 0; j < 2; ++j) {
-          const double a = std::abs(det) > 1e-300 ? (szz * sy[j] - sz * szy[j]) / det : xnew[imu + j];
-          (j == 0 ? res.bogdanov_takens_mu : res.bogdanov_takens_nu) = a;
-        }
-        if (xnew[iom] > omega_floor)  // a Hopf point with a resolved frequency
-          emit(make_point(xnew, iters, attempts, ydist(xnew, x), seconds_since(t_point), false));
-        return finish(hopf_curve_stop::bogdanov_takens,
-                      internal::concat("omega -> 0: the Hopf curve ends at a Bogdanov-Takens point near nu = ",
-                                       res.bogdanov_takens_nu, ", mu = ", res.bogdanov_takens_mu, " (last omega ",
-                                       xnew[iom], ")"));
-      }
-
-      // ---- landings on targets and bounds crossed by this step, in curve order ----
-      std::vector<std::pair<double, landing>> crossed;
-      for (const auto& l : lands) {
-        const double a = x[imu + l.row] - l.value, b = xnew[imu + l.row] - l.value;
-        if (a * b < 0 || (b == 0 && a != 0)) crossed.push_back({a / (a - b), l});
-      }
-      std::sort(crossed.begin(), crossed.end(), [](const auto& u, const auto& v) { return u.first < v.first; });
-      for (const auto& [theta, l] : crossed) {
-        const auto t_land = clock::now();
-        const vec<double> x0 = x + theta * (xnew - x);
-        double c[3] = {0, 0, 0};
-        c[l.row] = 1;
-        auto xl = correct(x0, s, c, l.value);
-        if (xl && !(xl->x[iom] > xl->omega_floor)) {
-          last_failure = internal::concat("the landed point has omega = ", xl->x[iom], ", not above the resolved frequency ",
-                                          xl->omega_floor);
-          xl.reset();
-        }
-        if (xl) {
-          emit(make_point(xl->x, xl->iterations, 1, ydist(xl->x, x), seconds_since(t_land), true));
-        } else {
-          if (opt.verbose && opt.log)
-            *opt.log << lab << ": landing on " << (l.row ? "nu = " : "mu = ") << l.value << " failed: " << last_failure
-                     << "\n";
-          if (!l.bound) res.missed_targets.push_back(l.value);
-        }
-        if (l.bound) {
-          if (!xl) emit(make_point(xnew, iters, attempts, ydist(xnew, x), seconds_since(t_point), false));
-          return finish(l.row ? hopf_curve_stop::nu_bounds : hopf_curve_stop::mu_bounds,
-                        internal::concat("reached ", l.row ? "nu = " : "mu = ", l.value,
-                                         xl ? "" : " (landing failed: the last point lies outside)"));
-        }
-        if (res.points.size() >= size_t(opt.max_points)) return finish(hopf_curve_stop::max_points, "max_points reached");
-        if (stop_requested) return finish(hopf_curve_stop::requested, "stop requested by stop_after");
-      }
-
-      // ---- accept ----
-      const double len = ydist(xnew, x);
-      arclength += len;
-      emit(make_point(xnew, iters, attempts, len, seconds_since(t_point), false));
-      if (res.points.size() >= size_t(opt.max_points)) return finish(hopf_curve_stop::max_points, "max_points reached");
-      if (stop_requested) return finish(hopf_curve_stop::requested, "stop requested by stop_after");
-      s = refresh_s(xnew);
-      x_prev = std::move(x);
-      rescale_p(x_prev, s);
-      t = xnew - x_prev;
-      const double tn = std::sqrt(ydot(t, t));
-      t /= tn;
-      x = std::move(xnew);
-      if (opt.detect_closed && arclength > 3 * len && ydist(x, x_first) < len)
-        return finish(hopf_curve_stop::closed_curve,
-                      internal::concat("the curve closed on its start after arclength ", arclength));
-      if (iters <= opt.fast_iterations) ds = std::min(opt.max_step, opt.growth * ds);
-    }
-  } catch (const error& e) {
-    const hopf_curve_point& lp = res.points.back();  // the start at least
-    const std::string where = internal::curve_failure_context(lab, res.points.size(), lp.nu, lp.mu, lp.omega);
-    if (opt.throw_on_failure) internal::rethrow_with_context(where, "");
-    return finish(hopf_curve_stop::step_failure, where + e.what());
-  }
+  require(h0.point.omega > opt.omega_min, lab, ": start point has omega = ", h0.point.omega,
+          " <= omega_min (not a Hopf point)");
+  const internal::hopf_curve_layout L(n, true, opt, resolve_normalisation<M>(opt.normalisation));
+  vec<double> x(L.N);
+  x.head(n) = h0.point.w;
+  L.set_p(x, h0.point.p);
+  x[L.imu] = h0.point.mu;
+  x[L.inu] = nu0;
+  x[L.iom] = h0.point.omega;
+  internal::hopf_curve_corrector<F> corr(family, L, opt);
+  hopf_curve_result res;
+  return internal::run_hopf_curve(corr, L, std::move(x), h0.report.iterations,
+                                  std::chrono::duration<double>(clock::now() - t_start).count(), opt, direction, res,
+                                  t_begin, internal::hopf_curve_stepper_options(opt, L));
 }
 
 }  // namespace aerohopf
