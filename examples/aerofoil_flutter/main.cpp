@@ -30,7 +30,8 @@
 //                               (at --incidence: boundary_<case>_<grid>_alpha<DEG>.csv, plus static_alpha:
 //                               the static pitch deflection at the flutter point, radians)
 //   crossing_check.csv (case,grid,mach,ubar_star,omega_star,ubar,omega)   every imaginary-axis crossing at
-//                               the jumps and last points (the library driver's check)
+//                               the jumps and last points (the library driver's check; at --incidence
+//                               the rising zeros of g of a V-g scan from 0.5 Ubar*)
 //   flutter_point_very_coarse.txt, spectra.csv (ubar,re,im)     very coarse, light, M = 0.5
 //   jump_check.csv              boundary jumps checked by dense spectra on the very coarse grid
 //   vg_<case>_<grid>_M<mach>.csv  mode,parameter,damping_g,frequency,re,im (parameter Ubar; mode 0
@@ -69,8 +70,10 @@ flutter_boundary_options driver_options(const options& o, const structural_case&
   fo.verbose = o.verbose;
   fo.label = c.name + " " + g.name;
   // the crossing check factorises i omega I - A_ff at every sampled frequency: ~1 s per LU on
-  // the medium grid, so there only with --crossing-medium
-  fo.check_crossings = o.jump_check && (g.stride >= 4 || (g.stride == 2 && o.crossing_medium));
+  // the medium grid, so there only with --crossing-medium; at an incidence it is a V-g scan by
+  // BILU-GMRES, on every grid
+  fo.check_crossings = o.crossing_check && (g.stride >= 4 || (g.stride == 2 && o.crossing_medium) ||
+                                            family.alpha() != 0.0);
   return fo;
 }
 
@@ -221,7 +224,7 @@ options parse(int argc, char** argv) {
     } else if (a == "--skip-vg") {
       o.vg = false;
     } else if (a == "--skip-jump-check") {
-      o.jump_check = false;
+      o.jump_check = o.crossing_check = false;
     } else if (a == "--skip-verify") {
       o.verify = false;
     } else if (a == "--skip-reduced") {
@@ -260,12 +263,12 @@ options parse(int argc, char** argv) {
   require(o.mach_min > 0 && o.mach_max >= o.mach_min && o.mach_max < 1, "need 0 < --mach-min <= --mach-max < 1 (got ",
           o.mach_min, ", ", o.mach_max, ")");
   if (o.incidence_deg != 0.0 && (o.spectra || o.jump_check || o.verify || o.reduced)) {
-    std::cout << "(--incidence: the spectra, jump check, time marching and reduced-model parts assume zero incidence; "
-                 "skipped)\n";
+    std::cout << "(--incidence: the spectra, dense jump check, time marching and reduced-model parts assume zero "
+                 "incidence; skipped; the driver's crossing check is a V-g scan)\n";
     o.spectra = o.jump_check = o.verify = o.reduced = false;
   }
   if (o.quick) {
-    o.jump_check = false;
+    o.jump_check = o.crossing_check = false;
     o.grids = {level_named("coarse")};
     o.verify_grid = level_named("coarse");
     o.mach_step = o.mach_step > 0 ? o.mach_step : 0.1;

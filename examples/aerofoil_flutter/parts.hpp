@@ -57,6 +57,7 @@ struct options {
   int vg_points = 40;
   std::string vg_solver = "auto";  // lu | krylov | auto (LU up to the coarse grid)
   bool crossing_medium = false;  // the crossing check on the medium grid too (~1 s per LU)
+  bool crossing_check = true;    // the driver's check of the jumps and last points
   bool verbose = false;
   grid_level verify_grid = level_named("medium");
 };

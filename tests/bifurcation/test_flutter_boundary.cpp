@@ -203,6 +203,10 @@ TEST(FlutterBoundary, BadInputIsRefused) {
   o.same_mode_cosine = 1.5;
   EXPECT_TRUE(test::contains(test::input_error_of([&] { trace_flutter_boundary(f, 8, {0.5}, nullptr, o); }),
                              "same_mode_cosine"));
+  o = options_for(f, 1.66, 0.75, "bad");
+  o.scan_delta = 0.5;  // wider than half the scan step: the check's last two values would not bracket mu*
+  EXPECT_TRUE(test::contains(test::input_error_of([&] { trace_flutter_boundary(f, 8, {0.5}, nullptr, o); }),
+                             "scan_delta 0.5"));
 }
 
 }  // namespace

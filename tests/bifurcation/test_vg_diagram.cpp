@@ -169,6 +169,44 @@ TEST(vg_diagram, halves_a_step_whose_overlap_is_too_low) {
   EXPECT_THROW(vg_diagram(sys, zero_state, {0.05, 1.85}, {{cplx(0, 1.0), {}}, {cplx(0, 2.0), {}}}, o), convergence_error);
 }
 
+// partial_on_lost_tracking: the same failure ends the diagram at the last parameter reached,
+// with the reason, instead of throwing; the points before it are those of the full diagram.
+TEST(vg_diagram, partial_diagram_ends_where_the_tracking_is_lost) {
+  const two_mode_system sys;
+  vg_options o = two_mode_options();
+  o.min_overlap = 0.999;
+  o.max_subdivisions = 0;
+  o.partial_on_lost_tracking = true;
+  const std::vector<cplx> shifts{cplx(0, 1.0), cplx(0, 2.0)};
+  const vg_result r = vg_diagram(sys, zero_state, {0.05, 0.25, 1.85}, {{shifts[0], {}}, {shifts[1], {}}}, o);
+  EXPECT_FALSE(r.complete);
+  EXPECT_NE(r.stop_reason.find("mode tracking lost between mu = 0.25 and 1.85"), std::string::npos) << r.stop_reason;
+  ASSERT_EQ(r.points.size(), 4u);  // two modes at 0.05 and 0.25
+  for (const auto& p : r.points) {
+    EXPECT_LE(p.mu, 0.25);
+    EXPECT_LT(std::abs(p.lambda - two_mode_system::lambda(p.mode, p.mu)), 1e-10);
+  }
+  EXPECT_TRUE(vg_diagram(sys, zero_state, {0.05, 0.25}, {{shifts[0], {}}, {shifts[1], {}}}, o).complete);
+}
+
+// stop_after_flutter: the diagram ends one listed parameter after mode 1's g first rises
+// through 0 (mu = 1.6, between 1.45 and 1.65), and that crossing is located as in the full one.
+TEST(vg_diagram, stop_after_flutter_ends_one_parameter_after_the_first_rising_zero) {
+  const two_mode_system sys;
+  vg_options o = two_mode_options();
+  o.stop_after_flutter = true;
+  const std::vector<double> mus = grid(0.05, 0.2, 14);  // 0.05 .. 2.65
+  const vg_result r = vg_diagram(sys, zero_state, mus, {{cplx(0, 1.0), {}}, {cplx(0, 2.0), {}}}, o);
+  EXPECT_FALSE(r.complete);
+  EXPECT_NE(r.stop_reason.find("stop_after_flutter"), std::string::npos) << r.stop_reason;
+  const auto m1 = r.mode(1);
+  ASSERT_FALSE(m1.empty());
+  EXPECT_NEAR(m1.back().mu, 1.85, 1e-12);  // 1.65 has g > 0, then one more
+  ASSERT_EQ(r.flutter.size(), 1u);
+  EXPECT_EQ(r.flutter[0].mode, 1);
+  EXPECT_NEAR(r.flutter[0].mu, 1.6, 1e-4);
+}
+
 // A solver object for every A - sigma I, and a factory of one solver per inverse power, give
 // the same diagram as the default LU.
 TEST(vg_diagram, solver_and_solver_factory_overloads) {

@@ -31,6 +31,12 @@
 // Check: every jump and the last point are tested by imaginary_axis_crossings (the parameter
 // enters the structural block as q(mu) B, the family's stiffness_factor): PASS iff the lowest
 // crossing above min_crossing_fraction mu* is the boundary point itself.
+//
+// Moving equilibrium (moving_equilibrium: a mean incidence, the static deflection grows with
+// mu): every point is a full Hopf system; where a branch ends, the tracer hand-over (it assumes a
+// fixed equilibrium) is replaced by a V-g scan at the next listed Mach number whose lowest rising
+// zero of the damping g starts the jump's Hopf solve, and the crossing check by a V-g scan from
+// below mu* (scan_* options).
 #include <Eigen/Core>
 
 #include <algorithm>
@@ -57,6 +63,7 @@
 #include "hopf_bordered.hpp"
 #include "hopf_curve_fixed_equilibrium.hpp"
 #include "inverse_power.hpp"
+#include "vg_diagram.hpp"
 
 namespace aerohopf {
 
@@ -128,9 +135,27 @@ struct flutter_boundary_options {
   /// The equilibrium moves with mu (e.g. a mean incidence: the static aeroelastic deflection
   /// depends on Ubar): each point is a FULL Hopf system solved by solve_hopf_krylov with
   /// hopf_krylov_options::full_system (no start refinement), the family's equilibrium(s, mu) is
-  /// the static aeroelastic solve, and neither the fixed-equilibrium tracer hand-over nor the
-  /// crossing check (both assume A0 independent of mu) applies: they are skipped.
+  /// the static aeroelastic solve. The fixed-equilibrium tracer hand-over and the axis-crossing
+  /// check assume A0 independent of mu; in their place come V-g scans (below).
   bool moving_equilibrium = false;
+  /// Moving equilibrium: V-g scans (vg_diagram with the equilibrium continued along mu, the
+  /// oscillatory modes of the structural block A_ss at the first value as starts, BILU-GMRES
+  /// inverse powers). Every scan starts at scan_from x the reference mu, where the aeroelastic
+  /// modes are still near the in-vacuo ones (NACA 0012 coarse, M = 0.7: from 0.75 Ubar* the
+  /// in-vacuo plunge shift is as far from its mode as from a flow eigenvalue, and inverse power
+  /// stalls), in steps of scan_lead_step up to scan_fine_from, then scan_step. Where a branch
+  /// ends (natural continuation fails down to 1/min_step_divisor), the next listed Mach number's
+  /// lowest rising zero of g below scan_to x the last point's mu starts the jump's full Hopf
+  /// solve. The check of every jump and the last point scans up to (1 - scan_step) mu*, then
+  /// (1 -+ scan_delta) mu*: PASS iff the lowest rising zero of g lies between the last two (the
+  /// point is the lowest crossing, and g rises through it). A scan misses an unstable band
+  /// narrower than its step (NACA 0012 coarse, alpha_0 = 1 deg, M = 0.6625: Ubar 1.553-1.56).
+  double scan_from = 0.5, scan_lead_step = 0.05, scan_fine_from = 0.75, scan_step = 0.02, scan_to = 1.6;
+  double scan_delta = 1e-3;
+  /// The scans' inverse-power tolerance (GMRES 10x below it) and mode-tracking overlap
+  /// (vg_options::min_overlap): a scan needs g to a few digits, and near coalescence the two
+  /// structural modes exchange shape faster than a tracking step of 1/16 of scan_step.
+  double scan_tolerance = 1e-7, scan_min_overlap = 0.6;
   /// Hand-over to the fixed-equilibrium Hopf-curve tracer (its step metric and bounds are the
   /// model's: set curve.mu_scale, nu_scale, omega_scale, mu_min, mu_max, fixed_equilibrium.fill_level...).
   bool handover = true;
@@ -139,7 +164,8 @@ struct flutter_boundary_options {
   double fold_tolerance = 0.005;   ///< the traced curve turning back in M by more: stop
   double retrace_distance = 0.1;   ///< in the tracer's metric: a point this close to the old trail is a retrace
   int handover_max_points = 200;
-  /// The crossing check of every jump and the last point (imaginary_axis_crossings).
+  /// The crossing check of every jump and the last point (imaginary_axis_crossings; a V-g scan
+  /// for a moving equilibrium).
   bool check_crossings = true;
   double crossing_omega_min = 0.05, crossing_omega_factor = 6.0, crossing_min_fraction = 0.2;
   double crossing_mu_tolerance = 1e-5, crossing_omega_tolerance = 1e-4;
@@ -158,7 +184,7 @@ struct flutter_boundary_point {
   /// (the steady solve where the stretch starts), not a steady solve at their Mach number
   bool own_steady = true;
   double cosine = NAN;  ///< structural cosine to the previous point (NAN for the first)
-  bool jump = false;    ///< starts a new branch (another mode)
+  bool jump = false;    ///< starts a new branch (another mode, or a moving-equilibrium V-g scan's crossing)
 };
 
 /// One attempt of natural continuation (accepted or not) or an arclength stretch.
@@ -252,6 +278,13 @@ inline void check_flutter_boundary_options(const flutter_boundary_options& o, co
   require(o.same_mode_cosine > 0 && o.same_mode_cosine < 1, where, ": same_mode_cosine must lie in (0, 1) (got ",
           o.same_mode_cosine, ")");
   require(o.min_step_divisor >= 1, where, ": min_step_divisor must be >= 1 (got ", o.min_step_divisor, ")");
+  require(o.scan_from > 0 && o.scan_lead_step > 0 && o.scan_step > 0 && o.scan_fine_from >= o.scan_from &&
+              o.scan_to > o.scan_fine_from + o.scan_step && o.scan_delta > 0 && o.scan_delta < 0.5 * o.scan_step &&
+              o.scan_fine_from < 1 - o.scan_step && o.scan_tolerance > 0 && o.scan_min_overlap >= 0 &&
+              o.scan_min_overlap <= 1,
+          where, ": V-g scans need 0 < scan_from <= scan_fine_from < 1 - scan_step, scan_to > scan_fine_from + scan_step, "
+          "steps > 0, 0 < scan_delta < scan_step / 2, scan_tolerance > 0, scan_min_overlap in [0, 1] (got scan_from ", o.scan_from, ", scan_fine_from ",
+          o.scan_fine_from, ", scan_to ", o.scan_to, ", scan_step ", o.scan_step, ", scan_delta ", o.scan_delta, ")");
   check_hopf_krylov_options(o.krylov, where);
 }
 
@@ -266,6 +299,89 @@ double structural_cosine(const F& family, const vec<std::complex<double>>& p0, c
 }
 
 namespace internal {
+
+/// The equilibrium of s at mu from w0, the one at mu0: the family's equilibrium_from where it has
+/// one (continuation in mu from a nearby state), else its equilibrium from scratch.
+template <flutter_family F>
+vec<double> family_equilibrium_near(const F& f, const typename F::system_type& s, const vec<double>& w0, double mu0,
+                                    double mu) {
+  if constexpr (requires { f.equilibrium_from(s, w0, mu0, mu); })
+    return f.equilibrium_from(s, w0, mu0, mu);
+  else
+    return f.equilibrium(s, mu);
+}
+
+struct moving_scan_result {
+  vg_result vg;
+  std::map<double, vec<double>> equilibria;  ///< every equilibrium the scan solved, by mu
+  const vg_flutter_point* lowest = nullptr;  ///< the lowest rising zero of g (in vg.flutter), if any
+  double seconds = 0;
+};
+
+/// V-g scan of s over mus (increasing) with the equilibrium continued from w0 (the one at mu_w0)
+/// along them, from the oscillatory modes of the structural block of A_ss at mus.front() (file
+/// comment of vg_diagram.hpp; flutter_boundary_options::scan_from). Ends where the tracking is
+/// lost and, with stop_after_flutter, one parameter after the first rising zero of g.
+template <flutter_family F>
+moving_scan_result moving_vg_scan(const F& f, const typename F::system_type& s, const vec<double>& w0, double mu_w0,
+                                  const std::vector<double>& mus, const flutter_boundary_options& o,
+                                  bool stop_after_flutter) {
+  using S = typename F::system_type;
+  constexpr int B = F::block_size;
+  const auto t0 = std::chrono::steady_clock::now();
+  moving_scan_result r;
+  if constexpr (!is_sparse_matrix_v<jacobian_t<S>>) {
+    throw input_error(o.label + ": the V-g scan of a moving equilibrium needs Eigen sparse Jacobians (vg_krylov_solvers)");
+  } else {
+    vec<double> w = w0;
+    double mu_w = mu_w0;
+    auto equilibrium = [&](double mu) {
+      if (const auto it = r.equilibria.find(mu); it != r.equilibria.end()) return it->second;
+      w = family_equilibrium_near(f, s, w, mu_w, mu);
+      mu_w = mu;
+      r.equilibria[mu] = w;
+      return w;
+    };
+    const vec<double> w1 = equilibrium(mus.front());
+    const Eigen::Index ns = s.structure_size();
+    const Eigen::MatrixXd a_ss =
+        krylov_exact_jacobian<B>(s, w1, mus.front(), o.label + " V-g scan").structure().bottomRightCorner(ns, ns);
+    const std::vector<vg_mode_start> starts = vg_mode_starts(a_ss);
+    if (starts.empty())
+      throw convergence_error(concat(o.label, " V-g scan: the structural block at mu = ", mus.front(),
+                                     " has no oscillatory mode to trace"));
+    vg_options vo;
+    vo.inverse_power.tolerance = o.scan_tolerance;
+    vo.min_overlap = o.scan_min_overlap;
+    vo.partial_on_lost_tracking = true;
+    vo.stop_after_flutter = stop_after_flutter;
+    vo.log = o.log;
+    vg_krylov_options ko;
+    ko.fill_level = o.fill_level;
+    ko.krylov.relative_tolerance = 0.1 * o.scan_tolerance;
+    r.vg = vg_diagram(s, equilibrium, mus, starts, vo, vg_krylov_solvers<B>(s, ko));
+    for (const auto& x : r.vg.flutter)
+      if (!r.lowest || x.mu < r.lowest->mu) r.lowest = &x;
+  }
+  r.seconds = flutter_seconds_since(t0);
+  return r;
+}
+
+/// The parameters of a V-g scan about mu (flutter_boundary_options::scan_from): scan_from to
+/// scan_fine_from in lead steps, then in scan_step up to `to` (all times |mu|); with `check`,
+/// up to (1 - scan_step) and then 1 -+ scan_delta instead.
+inline std::vector<double> scan_values(double mu, const flutter_boundary_options& o, double to, bool check) {
+  std::vector<double> v;
+  const double a = std::abs(mu);
+  for (double x = o.scan_from; x < o.scan_fine_from - 1e-9; x += o.scan_lead_step) v.push_back(a * x);
+  const double end = check ? 1 - o.scan_step : to;
+  for (int k = 0; o.scan_fine_from + k * o.scan_step <= end + 1e-9; ++k) v.push_back(a * (o.scan_fine_from + k * o.scan_step));
+  if (check) {
+    v.push_back(a * (1 - o.scan_delta));
+    v.push_back(a * (1 + o.scan_delta));
+  }
+  return v;
+}
 
 /// The state of one trace_flutter_boundary call (its lambdas made members).
 template <flutter_family F>
@@ -396,10 +512,58 @@ class flutter_boundary_tracer {
   /// The equilibrium at mu from w0, the one at mu0: the family's equilibrium_from where it has
   /// one (continuation in mu from a nearby state), else its equilibrium from scratch.
   vec<double> equilibrium_near(const S& s, const vec<double>& w0, double mu0, double mu) const {
-    if constexpr (requires { f_.equilibrium_from(s, w0, mu0, mu); })
-      return f_.equilibrium_from(s, w0, mu0, mu);
-    else
-      return f_.equilibrium(s, mu);
+    return family_equilibrium_near(f_, s, w0, mu0, mu);
+  }
+
+  /// Moving equilibrium, where the branch ends before the listed Mach number m: the lowest
+  /// rising zero of g of a V-g scan at m (flutter_boundary_options::scan_from) starts the full
+  /// Hopf solve (inverse power at the equilibrium there for the eigenvector). The scan's time is
+  /// the point's.
+  std::optional<flutter_boundary_point> moving_jump(double m) {
+    const auto t0 = clk::now();
+    const S s = f_.system(level_, m);
+    const double mu_last = pts_.back().mu;
+    const std::string label = label_at(m) + " (V-g scan)";
+    try {
+      const solved_flow& st = flow_at(s, m, mu_last);
+      const std::vector<double> mus = scan_values(mu_last, o_, o_.scan_to, false);
+      const moving_scan_result r = moving_vg_scan(f_, s, st.w, st.mu, mus, o_, true);
+      flutter_say(log_, "    %s: Ubar %.4f .. %.4f: %d inverse powers, %ld GMRES, %zu equilibria, %.2f s%s%s\n",
+                  label.c_str(), mus.front(), r.vg.points.empty() ? NAN : r.vg.points.back().mu, r.vg.inverse_powers,
+                  r.vg.linear_iterations, r.equilibria.size(), r.seconds, r.vg.complete ? "" : "; ",
+                  r.vg.stop_reason.c_str());
+      if (!r.lowest) {
+        flutter_say(log_, "    %s: no rising zero of g\n", label.c_str());
+        record(m, "V-g scan", "failed: no rising zero of g", flutter_seconds_since(t0));
+        rejected_ += flutter_seconds_since(t0);
+        return std::nullopt;
+      }
+      const double mu_c = r.lowest->mu, omega_c = r.lowest->frequency;
+      auto below = r.equilibria.upper_bound(mu_c);
+      if (below != r.equilibria.begin()) --below;
+      const vec<double> wc = equilibrium_near(s, below->second, below->first, mu_c);
+      hopf_start_krylov_options so;
+      so.fill_level = o_.fill_level;
+      so.krylov.restart = o_.start_restart;
+      eigen_pair ep;
+      hopf_point guess = hopf_start_krylov<B>(s, wc, mu_c, omega_c, so, &ep);
+      guess.mu = mu_c;
+      flutter_say(log_, "    %s: lowest rising zero of g (mode %d) at mu = %.5f, omega = %.5f; inverse power there: "
+                  "lambda = %+.6f %+.6fi\n", label.c_str(), r.lowest->mode, mu_c, omega_c, ep.lambda.real(), ep.lambda.imag());
+      const solved_flow sc{m, mu_c, wc, st.seconds, false, false};
+      auto p = hopf_at(s, m, sc, guess, label, "V-g scan");
+      if (!p) {
+        rejected_ += flutter_seconds_since(t0);
+        return std::nullopt;
+      }
+      p->hopf_seconds = flutter_seconds_since(t0);
+      return p;
+    } catch (const error& e) {
+      flutter_say(log_, "    %s failed: %s\n", label.c_str(), e.what());
+      record(m, "V-g scan", std::string("failed: ") + e.what(), flutter_seconds_since(t0));
+      rejected_ += flutter_seconds_since(t0);
+      return std::nullopt;
+    }
   }
 
   void write(flutter_boundary_point p, double cos, bool jump = false) {
@@ -863,8 +1027,15 @@ flutter_boundary flutter_boundary_tracer<F>::run() {
         flutter_say(log_, "    %s: no convergence from M = %.4f even with 1/%d of the Mach step\n", label.c_str(),
                     pts_.back().mach, o_.min_step_divisor);
         const double m_before = pts_.back().mach;
-        if (o_.handover && o_.moving_equilibrium)
-          flutter_say(log_, "    no hand-over: the Hopf-curve tracer assumes a fixed equilibrium\n");
+        if (o_.moving_equilibrium) {  // the tracer assumes a fixed equilibrium: the V-g scan at the listed Mach number
+          if (auto q = moving_jump(mach)) {
+            const double cq = cosine(pts_.back().point, q->point);
+            branch_start_ = pts_.size();
+            write(*q, cq, true);
+            step = full_step;
+            continue;
+          }
+        }
         if (o_.handover && !o_.moving_equilibrium)
           for (auto& q : arclength_bridge(pts_.back())) {
             const double cq = cosine(pts_.back().point, q.point);
@@ -875,7 +1046,8 @@ flutter_boundary flutter_boundary_tracer<F>::run() {
                       m_before);
           b_.stop_reason = "not continued past M = " + flutter_fixed(m_before, 5) +
                            " (natural continuation down to 1/" + std::to_string(o_.min_step_divisor) +
-                           " of the step and the arclength hand-over failed)";
+                           (o_.moving_equilibrium ? " of the step and the V-g scan at M = " + flutter_fixed(mach, 5) + " failed)"
+                                                  : " of the step and the arclength hand-over failed)");
           return std::move(b_);
         }
         step = full_step;  // natural continuation resumes from the stretch's last point
@@ -941,15 +1113,42 @@ crossing_check_record check_flutter_crossing(const F& family, int level, const f
   return c;
 }
 
-/// The points of a boundary whose lowest-crossing property is checked: the jumps (structural
-/// cosine below same_mode_cosine to the previous point) and the last point.
+/// The crossing check of one boundary point of a moving equilibrium: a V-g scan
+/// (internal::moving_vg_scan) up to (1 - scan_delta) mu* and one value above, (1 + scan_delta)
+/// mu*, the equilibrium continued from the point's, stopped after the first rising zero of g;
+/// PASS iff that lowest zero lies between the last two values (flutter_boundary_options::scan_from).
+template <flutter_family F>
+crossing_check_record check_flutter_crossing_scan(const F& family, int level, const flutter_boundary_point& p,
+                                                  const std::string& what, const flutter_boundary_options& o) {
+  const auto s = family.system(level, p.mach);
+  const std::vector<double> mus = internal::scan_values(p.mu, o, 1.0, true);
+  const internal::moving_scan_result r = internal::moving_vg_scan(family, s, p.point.w, p.mu, mus, o, true);
+  crossing_check_record c;
+  c.mach = p.mach;
+  c.mu = p.mu;
+  c.omega = p.omega;
+  c.what = what;
+  c.crossings = r.vg.flutter.size();
+  for (const auto& x : r.vg.flutter) c.all.emplace_back(x.mu, x.frequency);
+  if (r.lowest) {
+    c.lowest_mu = r.lowest->mu;
+    c.lowest_omega = r.lowest->frequency;
+  }
+  c.pass = r.lowest && c.lowest_mu >= mus[mus.size() - 2] && c.lowest_mu <= mus.back() &&
+           std::abs(c.lowest_omega - p.omega) <= o.scan_step * p.omega;
+  return c;
+}
+
+/// The points of a boundary whose lowest-crossing property is checked: the jumps (marked so, or
+/// structural cosine below same_mode_cosine to the previous point) and the last point.
 template <flutter_family F>
 std::vector<std::pair<std::size_t, const char*>> flutter_check_points(const F& family, const flutter_boundary& b,
                                                                       double same_mode_cosine = 0.9) {
   std::vector<std::pair<std::size_t, const char*>> at;
   const auto& p = b.points;
   for (std::size_t k = 1; k < p.size(); ++k)
-    if (structural_cosine(family, p[k - 1].point.p, p[k].point.p) < same_mode_cosine) at.emplace_back(k, "jump");
+    if (p[k].jump || structural_cosine(family, p[k - 1].point.p, p[k].point.p) < same_mode_cosine)
+      at.emplace_back(k, "jump");
   if (!p.empty() && (at.empty() || at.back().first != p.size() - 1)) at.emplace_back(p.size() - 1, "last point");
   return at;
 }
@@ -967,14 +1166,23 @@ flutter_boundary trace_flutter_boundary(const F& family, int level, const std::v
   if (coarser && !family.refines(coarser->level, level)) coarser = nullptr;
   internal::flutter_boundary_tracer<F> t(family, level, machs, coarser, opt);
   flutter_boundary b = t.run();
-  if (opt.check_crossings && !opt.moving_equilibrium)
+  if (opt.check_crossings)
     for (const auto& [k, what] : flutter_check_points(family, b, opt.same_mode_cosine)) {
       const auto t0 = std::chrono::steady_clock::now();
-      crossing_check_record c = check_flutter_crossing(family, level, b.points[k], what, opt);
+      crossing_check_record c;
+      try {
+        c = opt.moving_equilibrium ? check_flutter_crossing_scan(family, level, b.points[k], what, opt)
+                                   : check_flutter_crossing(family, level, b.points[k], what, opt);
+      } catch (const error& e) {  // a check that cannot be made fails
+        c.mach = b.points[k].mach;
+        c.mu = b.points[k].mu;
+        c.omega = b.points[k].omega;
+        c.what = std::string(what) + " (check failed: " + e.what() + ")";
+      }
       internal::flutter_say(opt.log,
                             "    crossing check M = %.4f (%s)  mu* = %.5f omega* = %.4f: %zu crossings, lowest mu = %.5f at "
                             "omega = %.4f -> %s  (%.1f s)\n",
-                            c.mach, what, c.mu, c.omega, c.crossings, c.lowest_mu, c.lowest_omega,
+                            c.mach, c.what.c_str(), c.mu, c.omega, c.crossings, c.lowest_mu, c.lowest_omega,
                             c.pass ? "lowest crossing (PASS)" : "FAIL", internal::flutter_seconds_since(t0));
       b.checks.push_back(std::move(c));
     }

@@ -92,6 +92,13 @@ struct vg_options {
   /// tracked part is noise that can overlap with anything. (The symmetric aerofoil has such
   /// eigenpairs: flow modes that put no lift or moment on the section, Ubar-independent.)
   double min_tracked_share = 1e-6;
+  /// Where the tracking is lost even after max_subdivisions halvings: false, convergence_error;
+  /// true, the diagram ends at the last parameter reached (vg_result::complete false, its
+  /// stop_reason the error's text), e.g. for a scan that needs only the lowest crossing.
+  bool partial_on_lost_tracking = false;
+  /// Stop one listed parameter after the first rising zero of g of any mode (the crossing's
+  /// cubic then has three of its four points): a scan for the lowest flutter point.
+  bool stop_after_flutter = false;
   bool verbose = false;
   std::ostream* log = &std::cout;
 };
@@ -120,6 +127,8 @@ struct vg_result {
   int subdivisions = 0;         ///< halved steps over the whole diagram
   int inverse_powers = 0;       ///< inverse-power solves (each one factorisation of A - sigma I)
   long linear_iterations = 0;   ///< Krylov iterations over all solves (0 with a direct solver)
+  bool complete = true;         ///< every listed parameter reached (see vg_options::partial_on_lost_tracking, stop_after_flutter)
+  std::string stop_reason;      ///< why not
 
   /// The points of one mode, in mu order.
   std::vector<vg_point> mode(int k) const {
@@ -433,10 +442,26 @@ vg_result vg_trace(const S& sys, const Equilibrium& equilibrium, const std::vect
     self(self, mu_from, mid, depth + 1, min_ov);
     self(self, mid, mu_to, depth + 1, min_ov);
   };
+  std::size_t rose_at = 0;  // the parameter where some mode's g first crossed zero from below (0: none yet)
   for (std::size_t j = 1; j < mus.size(); ++j) {
+    if (rose_at > 0 && j > rose_at + 1) {
+      res.complete = false;
+      res.stop_reason = internal::concat("stopped one parameter after the first rising zero of g (stop_after_flutter), at mu = ",
+                                         mus[j - 1]);
+      break;
+    }
     std::vector<double> min_ov(m, 1.0);
-    advance(advance, mus[j - 1], mus[j], 0, min_ov);
+    try {
+      advance(advance, mus[j - 1], mus[j], 0, min_ov);
+    } catch (const convergence_error& e) {
+      if (!opt.partial_on_lost_tracking) throw;
+      res.complete = false;
+      res.stop_reason = e.what();
+      break;
+    }
     for (int k = 0; k < m; ++k) {
+      if (opt.stop_after_flutter && rose_at == 0 && by_mode[k].back().damping < 0 && vg_damping(state[k].lambda) >= 0)
+        rose_at = j;
       by_mode[k].push_back({k, mus[j], state[k].lambda, vg_damping(state[k].lambda), std::abs(state[k].lambda.imag()),
                             min_ov[k], last_iterations[k], last_residual[k]});
       if (opt.verbose && opt.log)

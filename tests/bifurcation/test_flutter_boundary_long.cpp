@@ -1,0 +1,72 @@
+// trace_flutter_boundary with a moving equilibrium (bifurcation/flutter_boundary.hpp): the
+// pitch-plunge NACA 0012 at a mean incidence alpha_0 = 1 deg on the coarse grid, light case.
+// From M = 0.65 natural continuation cannot reach M = 0.70 (the branch folds back near M = 0.665),
+// (it ends at M = 0.6625), so the driver's V-g scan at M = 0.70 (damping of both structural modes along Ubar with the
+// static aeroelastic equilibrium continued) finds the lowest rising zero of g and starts the full
+// Hopf solve from it. Checked: the jump point is a Hopf point of the full system whose static
+// deflection is that of a separate static aeroelastic solve; it agrees with the scan's zero of g;
+// the crossing checks (V-g scans from 0.5 Ubar*) pass. Labelled long (about a minute).
+#include <aerohopf/bifurcation/flutter_boundary.hpp>
+#include <aerohopf/flow/naca_cgrid.hpp>
+#include <aerohopf/models/aerofoil_family.hpp>
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <numbers>
+
+using namespace aerohopf;
+using aerohopf::models::aerofoil_family;
+
+namespace {
+
+TEST(FlutterBoundaryMoving, BranchEndJumpsByVgScanAtAlphaOneDegree) {
+  structure::pitch_plunge_parameters sp;
+  sp.mu_s = 10.0;
+  const aerofoil_family f(flow::naca_cgrid(), sp, {}, std::numbers::pi / 180);
+  flutter_boundary_options o = f.boundary_options();
+  ASSERT_TRUE(o.moving_equilibrium);
+  o.start_mu = 1.56;
+  o.start_omega = 0.71;
+  o.label = "alpha1";
+  o.log = nullptr;
+  const flutter_boundary b = trace_flutter_boundary(f, 4, {0.65, 0.70}, nullptr, o);
+  ASSERT_TRUE(b.complete) << b.stop_reason;
+  // M = 0.65, the halved step's 0.6625 (the last point of the branch), and the jump at 0.70 (the
+  // example's coarse boundary at alpha_0 = 1 deg)
+  ASSERT_EQ(b.points.size(), 3u);
+  EXPECT_NEAR(b.points[0].mu, 1.556707, 2e-6);
+  EXPECT_NEAR(b.points[1].mach, 0.6625, 1e-12);
+  EXPECT_NEAR(b.points[1].mu, 1.556537, 2e-6);
+  const auto& p = b.points[2];
+  EXPECT_TRUE(p.jump);
+  EXPECT_NEAR(p.mach, 0.70, 1e-12);
+  // the jump is the scan's zero of g, far above the end of the first branch
+  EXPECT_NEAR(p.mu, 2.139307, 2e-5 * 2.14);
+  EXPECT_NEAR(p.omega, 0.685104, 2e-5);
+  bool scanned = false;
+  for (const auto& a : b.attempts) scanned = scanned || (a.kind == "V-g scan");
+  EXPECT_TRUE(scanned);
+  // a Hopf point of the full system: the residual at the returned point
+  const auto s = f.system(4, 0.70);
+  hopf_options ho;
+  const hopf_problem<models::aerofoil_system> pr(s, p.point, ho, "check");
+  EXPECT_LT(pr.residual(pr.start()).norm(), 1e-6);
+  // its equilibrium is the static aeroelastic one at Ubar*: a separate solve, continued from the
+  // one at Ubar = 1 in steps of 0.05 (the equilibrium is not unique there: Newton from the section
+  // at rest straight at Ubar*, or from Ubar = 1 in one step, lands on another branch, alpha =
+  // -0.052 rad)
+  vec<double> w = f.static_equilibrium(s, 1.0);
+  for (double u = 1.0; u < p.mu;) {
+    const double next = std::min(u + 0.05, p.mu);
+    w = f.static_equilibrium_from(s, w, u, next);
+    u = next;
+  }
+  const double alpha_static = w[w.size() - 2];
+  EXPECT_NEAR(p.point.w[p.point.w.size() - 2], alpha_static, 1e-8);
+  EXPECT_GT(alpha_static, 0.1);  // the section deflects by about 8.6 deg at this Ubar
+  // the crossing checks: the jump and the last point (the same) pass
+  ASSERT_FALSE(b.checks.empty());
+  for (const auto& c : b.checks) EXPECT_TRUE(c.pass) << c.what << " at M = " << c.mach << ": lowest " << c.lowest_mu;
+}
+
+}  // namespace
