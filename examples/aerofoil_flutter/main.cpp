@@ -99,6 +99,7 @@ flutter_boundary boundary_on(const options& o, const structural_case& c, const g
                static_cast<long long>(p.linear_iterations), p.hopf_seconds, p.steady_seconds});
   }
   if (!b.complete) std::cout << "  " << b.label << ": boundary incomplete: " << b.stop_reason << "\n";
+  if (b.complete && !b.skipped.empty()) std::cout << "  " << b.label << ": " << b.stop_reason << "\n";
   return b;
 }
 

@@ -9,6 +9,7 @@
 #include <stdexcept>
 #include <string>
 #include <string_view>
+#include <type_traits>
 
 namespace aerohopf {
 
@@ -33,11 +34,19 @@ struct singular_matrix_error : error {
 };
 
 namespace internal {
+/// One argument of concat, by its decayed type: a string literal is a const char*, so the
+/// stream insertion (an overload resolution over every operator<< in scope) is instantiated
+/// once per type, not once per literal length and argument list (hundreds of messages).
+template <class T>
+void put_one(std::ostream& os, const T& x) {
+  os << x;
+}
+
 template <class... Args>
 std::string concat(const Args&... args) {
   std::ostringstream os;
   os.precision(10);
-  (os << ... << args);
+  (put_one<std::decay_t<const Args>>(os, args), ...);
   return os.str();
 }
 }  // namespace internal
