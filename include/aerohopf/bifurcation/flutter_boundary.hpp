@@ -138,9 +138,14 @@ struct flutter_boundary_options {
   /// the static aeroelastic solve. The fixed-equilibrium tracer hand-over and the axis-crossing
   /// check assume A0 independent of mu; in their place come V-g scans (below).
   bool moving_equilibrium = false;
+  /// Moving equilibrium: where the full Hopf Newton fails from the continued guess, the secant
+  /// on the frozen-flow map (flutter_boundary_tracer::full_hopf): iterations and largest step
+  /// (relative to mu). NACA 0012 coarse, alpha_0 = 1 deg, M = 0.60-0.6625: 3-5 iterations.
+  int frozen_secant_iterations = 8;
+  double frozen_secant_max_step = 0.05;
   /// Moving equilibrium: V-g scans (vg_diagram with the equilibrium continued along mu, the
-  /// oscillatory modes of the structural block A_ss at the first value as starts, BILU-GMRES
-  /// inverse powers). Every scan starts at scan_from x the reference mu, where the aeroelastic
+  /// oscillatory modes of the structural block A_ss at the first value as starts, inverse powers
+  /// by sparse LU or BILU-GMRES: scan_direct_max_unknowns). Every scan starts at scan_from x the reference mu, where the aeroelastic
   /// modes are still near the in-vacuo ones (NACA 0012 coarse, M = 0.7: from 0.75 Ubar* the
   /// in-vacuo plunge shift is as far from its mode as from a flow eigenvalue, and inverse power
   /// stalls), in steps of scan_lead_step up to scan_fine_from, then scan_step. Where a branch
@@ -287,6 +292,9 @@ inline void check_flutter_boundary_options(const flutter_boundary_options& o, co
   require(o.same_mode_cosine > 0 && o.same_mode_cosine < 1, where, ": same_mode_cosine must lie in (0, 1) (got ",
           o.same_mode_cosine, ")");
   require(o.min_step_divisor >= 1, where, ": min_step_divisor must be >= 1 (got ", o.min_step_divisor, ")");
+  require(o.frozen_secant_iterations >= 0 && o.frozen_secant_max_step > 0, where,
+          ": frozen_secant_iterations must be >= 0 and frozen_secant_max_step > 0 (got ", o.frozen_secant_iterations,
+          ", ", o.frozen_secant_max_step, ")");
   require(o.scan_from > 0 && o.scan_lead_step > 0 && o.scan_step > 0 && o.scan_fine_from >= o.scan_from &&
               o.scan_to > o.scan_fine_from + o.scan_step && o.scan_delta > 0 && o.scan_delta < 0.5 * o.scan_step &&
               o.scan_fine_from < 1 - o.scan_step && o.scan_tolerance > 0 && o.scan_min_overlap >= 0 &&
@@ -496,30 +504,56 @@ class flutter_boundary_tracer {
     }
   }
 
-  /// The full Hopf system from the continued guess; where that fails, once more from a refined
-  /// start: the fixed-equilibrium Hopf point with the flow frozen at the guess (the start
-  /// refinement of the eigenvector, to 1e-4), and the equilibrium at its mu continued from the
-  /// guess's (g.w, the equilibrium at mu_w). A continued
-  /// eigenvector is far off where shocks move (||F|| 25-36 and a first step through negative
-  /// densities, NACA 0012 coarse at alpha_0 = 1 deg, M > 0.66).
+  /// The full Hopf system from the continued guess; where that fails, once more from the fixed
+  /// point of the FROZEN-FLOW MAP mu -> mu'(mu), the fixed-equilibrium Hopf parameter of
+  /// A(w_s(mu)) with w_s(mu) the equilibrium at mu (continued from g.w, the one at mu_w): at its
+  /// fixed point the fixed-equilibrium Hopf point is the full one. Secant iteration on
+  /// mu'(mu) - mu, each step at most frozen_secant_max_step |mu|, to |mu' - mu| <= 1e-6 |mu|;
+  /// then the full system from there. A continued eigenvector is far off where shocks move
+  /// (||F|| 25-36 and a first step through negative densities, NACA 0012 coarse at alpha_0 = 1
+  /// deg, M > 0.66); the frozen-flow map is a smooth function of one variable there.
   hopf_result full_hopf(const S& s, hopf_point g, double mu_w, const hopf_options& ho, const hopf_krylov_options& ko,
                         const std::string& label) {
     try {
       return solve_hopf_krylov<B>(s, g, ho, ko);
     } catch (const error& e) {
-      flutter_say(log_, "    %s: %s\n    -> again from the fixed-equilibrium Hopf point at the frozen flow\n",
-                  label.c_str(), e.what());
+      flutter_say(log_, "    %s: %s\n    -> again from the fixed point of the frozen-flow map (secant)\n", label.c_str(),
+                  e.what());
     }
-    hopf_options fo = hopf_opts(label + " (fixed-equilibrium start)", true);
-    fo.newton.abs_tolerance = std::max(o_.tolerance, 1e-4);
-    fo.equilibrium_tolerance = 1e300;  // w is the equilibrium of the guess's mu, not of the point's
+    hopf_options fo = hopf_opts(label + " (frozen flow)", true);
+    fo.newton.abs_tolerance = std::max(o_.tolerance, 1e-6);
+    fo.equilibrium_tolerance = 1e300;  // w is the equilibrium at another mu than the point's
     hopf_krylov_options kf = o_.krylov;
     kf.fill_level = o_.fill_level;
-    const hopf_result h0 = solve_hopf_krylov<B>(s, g, fo, kf);
-    g.p = h0.point.p;
-    g.mu = o_.parameter_even ? std::abs(h0.point.mu) : h0.point.mu;
-    g.omega = h0.point.omega;
-    g.w = equilibrium_near(s, g.w, mu_w, g.mu);
+    // mu'(mu) at g.w = w_s(mu): g's eigenvector and frequency are updated as a start for the next
+    auto frozen = [&](hopf_point& h) {
+      const hopf_result r = solve_hopf_krylov<B>(s, h, fo, kf);
+      h.p = r.point.p;
+      h.omega = r.point.omega;
+      return o_.parameter_even ? std::abs(r.point.mu) : r.point.mu;
+    };
+    const double max_step = o_.frozen_secant_max_step;
+    auto clamp_step = [&](double from, double to) {
+      const double d = max_step * std::abs(from);
+      return std::clamp(to, from - d, from + d);
+    };
+    double mu0 = mu_w;
+    double r0 = frozen(g) - mu0;
+    double mu1 = clamp_step(mu0, mu0 + r0);
+    g.w = equilibrium_near(s, g.w, mu0, mu1);
+    for (int it = 1; it <= o_.frozen_secant_iterations; ++it) {
+      g.mu = mu1;
+      const double r1 = frozen(g) - mu1;
+      if (o_.verbose)
+        flutter_say(log_, "    %s: frozen-flow secant %d: mu = %.9f, mu' - mu = %+.3e\n", label.c_str(), it, mu1, r1);
+      if (std::abs(r1) <= 1e-6 * std::abs(mu1)) break;
+      const double mu2 = clamp_step(mu1, r1 != r0 ? mu1 - r1 * (mu1 - mu0) / (r1 - r0) : mu1 + r1);
+      mu0 = mu1;
+      r0 = r1;
+      g.w = equilibrium_near(s, g.w, mu1, mu2);
+      mu1 = mu2;
+    }
+    g.mu = mu1;
     return solve_hopf_krylov<B>(s, g, ho, ko);
   }
 
