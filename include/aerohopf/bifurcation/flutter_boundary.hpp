@@ -145,10 +145,11 @@ struct flutter_boundary_options {
   double frozen_secant_max_step = 0.05;
   /// Moving equilibrium: V-g scans (vg_diagram with the equilibrium continued along mu, the
   /// oscillatory modes of the structural block A_ss at the first value as starts, inverse powers
-  /// by sparse LU or BILU-GMRES: scan_direct_max_unknowns). Every scan starts at scan_from x the reference mu, where the aeroelastic
-  /// modes are still near the in-vacuo ones (NACA 0012 coarse, M = 0.7: from 0.75 Ubar* the
-  /// in-vacuo plunge shift is as far from its mode as from a flow eigenvalue, and inverse power
-  /// stalls), in steps of scan_lead_step up to scan_fine_from, then scan_step. Where a branch
+  /// by sparse LU or BILU-GMRES: scan_direct_max_unknowns). Every scan starts at scan_from x the
+  /// reference mu, where the aeroelastic modes are still near the in-vacuo ones (NACA 0012
+  /// coarse, M = 0.7: from 0.75 Ubar* the in-vacuo plunge shift is as far from its mode as from a
+  /// flow eigenvalue, and inverse power stalls), in steps of scan_lead_step up to scan_fine_from,
+  /// then scan_step. Where a branch
   /// ends (natural continuation fails down to 1/min_step_divisor), the next listed Mach number's
   /// lowest rising zero of g below scan_to x the last point's mu starts the jump's full Hopf
   /// solve. The check of every jump and the last point scans up to (1 - scan_step) mu*, then
@@ -299,9 +300,11 @@ inline void check_flutter_boundary_options(const flutter_boundary_options& o, co
               o.scan_to > o.scan_fine_from + o.scan_step && o.scan_delta > 0 && o.scan_delta < 0.5 * o.scan_step &&
               o.scan_fine_from < 1 - o.scan_step && o.scan_tolerance > 0 && o.scan_min_overlap >= 0 &&
               o.scan_min_overlap <= 1,
-          where, ": V-g scans need 0 < scan_from <= scan_fine_from < 1 - scan_step, scan_to > scan_fine_from + scan_step, "
-          "steps > 0, 0 < scan_delta < scan_step / 2, scan_tolerance > 0, scan_min_overlap in [0, 1] (got scan_from ", o.scan_from, ", scan_fine_from ",
-          o.scan_fine_from, ", scan_to ", o.scan_to, ", scan_step ", o.scan_step, ", scan_delta ", o.scan_delta, ")");
+          where,
+          ": V-g scans need 0 < scan_from <= scan_fine_from < 1 - scan_step, scan_to > scan_fine_from + scan_step, "
+          "steps > 0, 0 < scan_delta < scan_step / 2, scan_tolerance > 0, scan_min_overlap in [0, 1] (got scan_from ",
+          o.scan_from, ", scan_fine_from ", o.scan_fine_from, ", scan_to ", o.scan_to, ", scan_step ", o.scan_step,
+          ", scan_delta ", o.scan_delta, ")");
   check_hopf_krylov_options(o.krylov, where);
 }
 
@@ -1104,8 +1107,7 @@ flutter_boundary flutter_boundary_tracer<F>::run() {
                       m_before);
           b_.stop_reason = "not continued past M = " + flutter_fixed(m_before, 5) +
                            " (natural continuation down to 1/" + std::to_string(o_.min_step_divisor) +
-                           (o_.moving_equilibrium ? " of the step and the V-g scan at M = " + flutter_fixed(mach, 5) + " failed)"
-                                                  : " of the step and the arclength hand-over failed)");
+                           " of the step and the arclength hand-over failed)";
           return std::move(b_);
         }
         step = full_step;  // natural continuation resumes from the stretch's last point
