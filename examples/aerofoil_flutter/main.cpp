@@ -70,8 +70,8 @@ flutter_boundary_options driver_options(const options& o, const structural_case&
   fo.verbose = o.verbose;
   fo.label = c.name + " " + g.name;
   // the crossing check factorises i omega I - A_ff at every sampled frequency: ~1 s per LU on
-  // the medium grid, so there only with --crossing-medium; at an incidence it is a V-g scan by
-  // BILU-GMRES, on every grid
+  // the medium grid, so there only with --crossing-medium; at an incidence it is a V-g scan
+  // (inverse powers by sparse LU up to 20,000 unknowns), on every grid
   fo.check_crossings = o.crossing_check && (g.stride >= 4 || (g.stride == 2 && o.crossing_medium) ||
                                             family.alpha() != 0.0);
   return fo;

@@ -5,7 +5,8 @@
 // static aeroelastic equilibrium continued) finds the lowest rising zero of g and starts the full
 // Hopf solve from it. Checked: the jump point is a Hopf point of the full system whose static
 // deflection is that of a separate static aeroelastic solve; it agrees with the scan's zero of g;
-// the crossing checks (V-g scans from 0.5 Ubar*) pass. Labelled long (about a minute).
+// the crossing checks (V-g scans from 0.5 Ubar*) pass. Then the skip of a listed Mach number
+// without a flutter point in the scan. Labelled long (about three minutes).
 #include <aerohopf/bifurcation/flutter_boundary.hpp>
 #include <aerohopf/flow/naca_cgrid.hpp>
 #include <aerohopf/models/aerofoil_family.hpp>
@@ -65,6 +66,34 @@ TEST(FlutterBoundaryMoving, BranchEndJumpsByVgScanAtAlphaOneDegree) {
   EXPECT_NEAR(p.point.w[p.point.w.size() - 2], alpha_static, 1e-8);
   EXPECT_GT(alpha_static, 0.1);  // the section deflects by about 8.6 deg at this Ubar
   // the crossing checks: the jump and the last point (the same) pass
+  ASSERT_FALSE(b.checks.empty());
+  for (const auto& c : b.checks) EXPECT_TRUE(c.pass) << c.what << " at M = " << c.mach << ": lowest " << c.lowest_mu;
+}
+
+// A listed Mach number whose scan finds no rising zero of g is skipped with the reason, and the
+// boundary goes on: with the scans capped at 1.25 x the branch's last Ubar (1.9457), M = 0.70
+// (its flutter point is at 2.139) is skipped, and the boundary goes on from M = 0.6625 to the
+// point of the example's coarse boundary at M = 0.75 (1.849328).
+TEST(FlutterBoundaryMoving, MachWithoutFlutterInTheScanIsSkipped) {
+  structure::pitch_plunge_parameters sp;
+  sp.mu_s = 10.0;
+  const aerofoil_family f(flow::naca_cgrid(), sp, {}, std::numbers::pi / 180);
+  flutter_boundary_options o = f.boundary_options();
+  o.start_mu = 1.56;
+  o.start_omega = 0.71;
+  o.scan_to = 1.25;
+  o.label = "alpha1 skip";
+  o.log = nullptr;
+  const flutter_boundary b = trace_flutter_boundary(f, 4, {0.65, 0.70, 0.75}, nullptr, o);
+  ASSERT_TRUE(b.complete) << b.stop_reason;
+  ASSERT_EQ(b.skipped.size(), 1u);
+  EXPECT_NEAR(b.skipped[0].first, 0.70, 1e-12);
+  EXPECT_NE(b.skipped[0].second.find("no rising zero of g"), std::string::npos) << b.skipped[0].second;
+  EXPECT_NE(b.stop_reason.find("0.7000"), std::string::npos) << b.stop_reason;
+  ASSERT_EQ(b.points.size(), 3u);
+  const auto& p = b.points.back();
+  EXPECT_NEAR(p.mach, 0.75, 1e-12);
+  EXPECT_NEAR(p.mu, 1.849328, 2e-5 * 1.85);
   ASSERT_FALSE(b.checks.empty());
   for (const auto& c : b.checks) EXPECT_TRUE(c.pass) << c.what << " at M = " << c.mach << ": lowest " << c.lowest_mu;
 }

@@ -338,14 +338,18 @@ struct moving_scan_result {
   double seconds = 0;
 };
 
-/// V-g scan of s over mus (increasing) with the equilibrium continued from w0 (the one at mu_w0)
-/// along them, from the oscillatory modes of the structural block of A_ss at mus.front() (file
-/// comment of vg_diagram.hpp; flutter_boundary_options::scan_from). Ends where the tracking is
-/// lost and, with stop_after_flutter, one parameter after the first rising zero of g.
+/// V-g scan of s over mus (increasing), from the oscillatory modes of the structural block of
+/// A_ss at mus.front() (file comment of vg_diagram.hpp; flutter_boundary_options::scan_from).
+/// The equilibrium is the family's from scratch at mus.front() (w_first if the caller has it),
+/// continued up along mus: below the static divergence the static equilibrium is unique, past it
+/// not (NACA 0012 coarse, alpha_0 = 1 deg, M = 0.70, Ubar = 2.14: +0.154 rad continued up from
+/// Ubar = 1, -0.052 rad from rest in one step), so the scan follows the branch reached by a
+/// rising speed. Ends where the tracking or the equilibrium is lost and, with
+/// stop_after_flutter, one parameter after the first rising zero of g.
 template <flutter_family F>
-moving_scan_result moving_vg_scan(const F& f, const typename F::system_type& s, const vec<double>& w0, double mu_w0,
-                                  const std::vector<double>& mus, const flutter_boundary_options& o,
-                                  bool stop_after_flutter) {
+moving_scan_result moving_vg_scan(const F& f, const typename F::system_type& s, const std::vector<double>& mus,
+                                  const flutter_boundary_options& o, bool stop_after_flutter,
+                                  const vec<double>* w_first = nullptr) {
   using S = typename F::system_type;
   constexpr int B = F::block_size;
   const auto t0 = std::chrono::steady_clock::now();
@@ -353,8 +357,9 @@ moving_scan_result moving_vg_scan(const F& f, const typename F::system_type& s, 
   if constexpr (!is_sparse_matrix_v<jacobian_t<S>>) {
     throw input_error(o.label + ": the V-g scan of a moving equilibrium needs Eigen sparse Jacobians (vg_krylov_solvers)");
   } else {
-    vec<double> w = w0;
-    double mu_w = mu_w0;
+    vec<double> w = w_first ? *w_first : f.equilibrium(s, mus.front());
+    double mu_w = mus.front();
+    r.equilibria[mu_w] = w;
     auto equilibrium = [&](double mu) {
       if (const auto it = r.equilibria.find(mu); it != r.equilibria.end()) return it->second;
       w = family_equilibrium_near(f, s, w, mu_w, mu);
@@ -362,7 +367,7 @@ moving_scan_result moving_vg_scan(const F& f, const typename F::system_type& s, 
       r.equilibria[mu] = w;
       return w;
     };
-    const vec<double> w1 = equilibrium(mus.front());
+    const vec<double>& w1 = r.equilibria.begin()->second;
     const Eigen::Index ns = s.structure_size();
     const Eigen::MatrixXd a_ss =
         krylov_exact_jacobian<B>(s, w1, mus.front(), o.label + " V-g scan").structure().bottomRightCorner(ns, ns);
@@ -573,25 +578,26 @@ class flutter_boundary_tracer {
   std::optional<flutter_boundary_point> moving_jump(double m) {
     const auto t0 = clk::now();
     const S s = f_.system(level_, m);
-    const double mu_last = pts_.back().mu;
     const std::string label = label_at(m) + " (V-g scan)";
+    auto fail = [&](std::string why) -> std::optional<flutter_boundary_point> {
+      scan_failure_ = std::move(why);
+      flutter_say(log_, "    %s: %s\n", label.c_str(), scan_failure_.c_str());
+      record(m, "V-g scan", "failed: " + scan_failure_, flutter_seconds_since(t0));
+      rejected_ += flutter_seconds_since(t0);
+      return std::nullopt;
+    };
     try {
-      const solved_flow& st = flow_at(s, m, mu_last);
-      const std::vector<double> mus = scan_values(mu_last, o_, o_.scan_to, false);
-      const moving_scan_result r = moving_vg_scan(f_, s, st.w, st.mu, mus, o_, true);
+      const std::vector<double> mus = scan_values(pts_.back().mu, o_, o_.scan_to, false);
+      const solved_flow& st = flow_at(s, m, mus.front());  // the cost unit; the scan's start if solved there
+      const moving_scan_result r = moving_vg_scan(f_, s, mus, o_, true, st.mu == mus.front() ? &st.w : nullptr);
       flutter_say(log_, "    %s: Ubar %.4f .. %.4f: %d inverse powers, %ld GMRES, %zu equilibria, %.2f s%s%s\n",
                   label.c_str(), mus.front(), r.vg.points.empty() ? NAN : r.vg.points.back().mu, r.vg.inverse_powers,
                   r.vg.linear_iterations, r.equilibria.size(), r.seconds, r.vg.complete ? "" : "; ",
                   r.vg.stop_reason.c_str());
-      if (!r.lowest) {
-        scan_failure_ = concat("no rising zero of g for Ubar in ", mus.front(), " .. ",
-                               r.vg.points.empty() ? NAN : r.vg.points.back().mu,
-                               r.vg.complete ? std::string() : " (" + r.vg.stop_reason + ")");
-        flutter_say(log_, "    %s: %s\n", label.c_str(), scan_failure_.c_str());
-        record(m, "V-g scan", "failed: no rising zero of g", flutter_seconds_since(t0));
-        rejected_ += flutter_seconds_since(t0);
-        return std::nullopt;
-      }
+      if (!r.lowest)
+        return fail(concat("no rising zero of g for Ubar in ", mus.front(), " .. ",
+                           r.vg.points.empty() ? NAN : r.vg.points.back().mu,
+                           r.vg.complete ? std::string() : " (" + r.vg.stop_reason + ")"));
       const double mu_c = r.lowest->mu, omega_c = r.lowest->frequency;
       auto below = r.equilibria.upper_bound(mu_c);
       if (below != r.equilibria.begin()) --below;
@@ -606,19 +612,11 @@ class flutter_boundary_tracer {
                   "lambda = %+.6f %+.6fi\n", label.c_str(), r.lowest->mode, mu_c, omega_c, ep.lambda.real(), ep.lambda.imag());
       const solved_flow sc{m, mu_c, wc, st.seconds, false, false};
       auto p = hopf_at(s, m, sc, guess, label, "V-g scan");
-      if (!p) {
-        scan_failure_ = concat("the Hopf solve from the scan's zero of g at Ubar = ", mu_c, " failed");
-        rejected_ += flutter_seconds_since(t0);
-        return std::nullopt;
-      }
+      if (!p) return fail(concat("the Hopf solve from the scan's zero of g at Ubar = ", mu_c, " failed"));
       p->hopf_seconds = flutter_seconds_since(t0);
       return p;
     } catch (const error& e) {
-      scan_failure_ = e.what();
-      flutter_say(log_, "    %s failed: %s\n", label.c_str(), e.what());
-      record(m, "V-g scan", std::string("failed: ") + e.what(), flutter_seconds_since(t0));
-      rejected_ += flutter_seconds_since(t0);
-      return std::nullopt;
+      return fail(e.what());
     }
   }
 
@@ -1186,7 +1184,7 @@ crossing_check_record check_flutter_crossing_scan(const F& family, int level, co
                                                   const std::string& what, const flutter_boundary_options& o) {
   const auto s = family.system(level, p.mach);
   const std::vector<double> mus = internal::scan_values(p.mu, o, 1.0, true);
-  const internal::moving_scan_result r = internal::moving_vg_scan(family, s, p.point.w, p.mu, mus, o, true);
+  const internal::moving_scan_result r = internal::moving_vg_scan(family, s, mus, o, true);
   crossing_check_record c;
   c.mach = p.mach;
   c.mu = p.mu;

@@ -92,9 +92,10 @@ struct vg_options {
   /// tracked part is noise that can overlap with anything. (The symmetric aerofoil has such
   /// eigenpairs: flow modes that put no lift or moment on the section, Ubar-independent.)
   double min_tracked_share = 1e-6;
-  /// Where the tracking is lost even after max_subdivisions halvings: false, convergence_error;
-  /// true, the diagram ends at the last parameter reached (vg_result::complete false, its
-  /// stop_reason the error's text), e.g. for a scan that needs only the lowest crossing.
+  /// Where the tracking is lost even after max_subdivisions halvings, or the equilibrium callable
+  /// throws convergence_error (e.g. a static equilibrium lost past divergence): false, the error
+  /// propagates; true, the diagram ends at the last parameter reached (vg_result::complete false,
+  /// its stop_reason the error's text), e.g. for a scan that needs only the lowest crossing.
   bool partial_on_lost_tracking = false;
   /// Stop one listed parameter after the first rising zero of g of any mode (the crossing's
   /// cubic then has three of its four points): a scan for the lowest flutter point.
