@@ -115,6 +115,12 @@ concept system_family = std::invocable<const F&, double> &&
 template <system_family F>
 using family_system_t = std::remove_cvref_t<std::invoke_result_t<const F&, double>>;
 
+/// The family type the tracers are instantiated with: every lambda is a type of its own, so the
+/// public entry points erase it and the tracer is compiled once per system type (one indirect
+/// call per system built costs nothing beside the solves on it).
+template <class S>
+using family_function = std::function<S(double)>;
+
 struct hopf_curve_point {
   double nu = 0, mu = 0, omega = 0;
   vec<double> w;                 ///< equilibrium
@@ -643,14 +649,10 @@ class hopf_curve_corrector : hopf_curve_corrector_base<F> {
   family_cache<F, S> cur_, plus_, minus_;
   direct_solver<M> lu_;
 };
-}  // namespace internal
 
-/// Traces the Hopf curve of family(nu) through the Hopf point `start` of family(nu0) (a guess:
-/// it is first converged by solve_hopf at fixed nu0), initially in the direction of increasing
-/// (direction = +1) or decreasing (-1) nu. See the file comment.
 template <system_family F>
-hopf_curve_result trace_hopf_curve(const F& family, double nu0, const hopf_point& start,
-                                   const hopf_curve_options& opt = {}, int direction = +1) {
+hopf_curve_result trace_hopf_curve_erased(const F& family, double nu0, const hopf_point& start,
+                                          const hopf_curve_options& opt, int direction) {
   using S = family_system_t<F>;
   using M = jacobian_t<S>;
   using clock = std::chrono::steady_clock;
@@ -687,7 +689,18 @@ hopf_curve_result trace_hopf_curve(const F& family, double nu0, const hopf_point
   hopf_curve_result res;
   return internal::run_hopf_curve(corr, L, std::move(x), h0.report.iterations,
                                   std::chrono::duration<double>(clock::now() - t_start).count(), opt, direction, res,
-                                  t_begin, internal::hopf_curve_stepper_options(opt, L));
+                                  t_begin, hopf_curve_stepper_options(opt, L));
+}
+}  // namespace internal
+
+/// Traces the Hopf curve of family(nu) through the Hopf point `start` of family(nu0) (a guess:
+/// it is first converged by solve_hopf at fixed nu0), initially in the direction of increasing
+/// (direction = +1) or decreasing (-1) nu. See the file comment.
+template <system_family F>
+hopf_curve_result trace_hopf_curve(const F& family, double nu0, const hopf_point& start,
+                                   const hopf_curve_options& opt = {}, int direction = +1) {
+  return internal::trace_hopf_curve_erased(family_function<family_system_t<F>>(std::cref(family)), nu0, start, opt,
+                                           direction);
 }
 
 }  // namespace aerohopf

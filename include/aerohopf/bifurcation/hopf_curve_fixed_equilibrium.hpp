@@ -685,18 +685,11 @@ class fixed_equilibrium_hopf_corrector : hopf_curve_corrector_base<F> {
   fixed_equilibrium_hopf_curve_stats acc_, step_costs_;  // costs since the last emitted point; of the step
   bool joint_now_;
 };
-}  // namespace internal
 
-/// Traces the fixed-equilibrium Hopf curve of family(nu) through the Hopf point `start` of family(nu0)
-/// (a guess: start.w an approximate equilibrium at nu0, polished by the nested steady Newton;
-/// then (p, mu, omega) converged by solve_hopf_krylov<B> at fixed nu0), initially towards
-/// increasing (direction = +1) or decreasing (-1) nu. B: block size of the unknowns for BILU
-/// (4 for 2D Euler + pitch-plunge). See the file comment.
 template <int B, system_family F>
-  requires is_sparse_matrix_v<jacobian_t<family_system_t<F>>>
-fixed_equilibrium_hopf_curve_result trace_fixed_equilibrium_hopf_curve(const F& family, double nu0, const hopf_point& start,
-                                                       const hopf_curve_options& opt = {}, int direction = +1,
-                                                       const fixed_equilibrium_hopf_curve_options& sopt = {}) {
+fixed_equilibrium_hopf_curve_result trace_fixed_equilibrium_hopf_curve_erased(
+    const F& family, double nu0, const hopf_point& start, const hopf_curve_options& opt, int direction,
+    const fixed_equilibrium_hopf_curve_options& sopt) {
   using clock = std::chrono::steady_clock;
   const auto t_begin = clock::now();
   using S = family_system_t<F>;
@@ -744,6 +737,21 @@ fixed_equilibrium_hopf_curve_result trace_fixed_equilibrium_hopf_curve(const F& 
   return internal::run_hopf_curve(corr, L, std::move(x), h0.report.iterations,
                                   std::chrono::duration<double>(clock::now() - t_start).count(), opt, direction, res,
                                   t_begin, so);
+}
+}  // namespace internal
+
+/// Traces the fixed-equilibrium Hopf curve of family(nu) through the Hopf point `start` of family(nu0)
+/// (a guess: start.w an approximate equilibrium at nu0, polished by the nested steady Newton;
+/// then (p, mu, omega) converged by solve_hopf_krylov<B> at fixed nu0), initially towards
+/// increasing (direction = +1) or decreasing (-1) nu. B: block size of the unknowns for BILU
+/// (4 for 2D Euler + pitch-plunge). See the file comment.
+template <int B, system_family F>
+  requires is_sparse_matrix_v<jacobian_t<family_system_t<F>>>
+fixed_equilibrium_hopf_curve_result trace_fixed_equilibrium_hopf_curve(const F& family, double nu0, const hopf_point& start,
+                                                       const hopf_curve_options& opt = {}, int direction = +1,
+                                                       const fixed_equilibrium_hopf_curve_options& sopt = {}) {
+  return internal::trace_fixed_equilibrium_hopf_curve_erased<B>(family_function<family_system_t<F>>(std::cref(family)),
+                                                                nu0, start, opt, direction, sopt);
 }
 
 }  // namespace aerohopf
