@@ -188,6 +188,38 @@ TEST(FlutterBoundary, CostsArePureFunctionsOfThePoints) {
   EXPECT_DOUBLE_EQ(boundary_cost_with_coarser(b, coarse, listed), (1.0 + 0.5 + 2.0 + 1.0 + 1.0 + 2.0) / 4.0);
 }
 
+// The points checked by the crossing test: a marked jump, a change of mode (structural cosine
+// below the threshold), the first point past a skipped Mach number, and the last point, each once.
+TEST(FlutterBoundary, CheckPointsAreJumpsModeChangesPointsPastASkipAndTheLast) {
+  const auto f = family(10.0);
+  using cvec = vec<std::complex<double>>;
+  auto pt = [](double m, const cvec& p, bool jump) {
+    flutter_boundary_point q;
+    q.mach = m;
+    q.point.p = p;
+    q.jump = jump;
+    return q;
+  };
+  const cvec plunge = (cvec(6) << 0, 0, 1, 0, std::complex<double>(0, 1), 0).finished();
+  const cvec pitch = (cvec(6) << 0, 0, 0, 1, 0, std::complex<double>(0, 1)).finished();
+  flutter_boundary b;
+  b.points = {pt(0.50, plunge, false), pt(0.55, plunge, false), pt(0.60, pitch, false), pt(0.65, pitch, true),
+              pt(0.75, pitch, false), pt(0.80, pitch, false), pt(0.85, pitch, false)};
+  b.skipped = {{0.70, "no rising zero of g"}};
+  const auto at = flutter_check_points(f, b, 0.9);
+  ASSERT_EQ(at.size(), 4u);
+  EXPECT_EQ(at[0].first, 2u);  // the mode changes
+  EXPECT_STREQ(at[0].second, "jump");
+  EXPECT_EQ(at[1].first, 3u);  // marked
+  EXPECT_STREQ(at[1].second, "jump");
+  EXPECT_EQ(at[2].first, 4u);  // continued across M = 0.70
+  EXPECT_STREQ(at[2].second, "past a skipped Mach number");
+  EXPECT_EQ(at[3].first, 6u);
+  EXPECT_STREQ(at[3].second, "last point");
+  b.skipped.clear();
+  EXPECT_EQ(flutter_check_points(f, b, 0.9).size(), 3u);
+}
+
 TEST(FlutterBoundary, BadInputIsRefused) {
   const auto f = family(10.0);
   flutter_boundary_options o = options_for(f, 1.66, 0.75, "bad");

@@ -28,9 +28,10 @@
 // to the next accepted point's hopf_seconds, so the points' hopf_seconds add up to the whole
 // work beyond one steady solve per point. flutter_boundary_costs is a pure function of them.
 //
-// Check: every jump and the last point are tested by imaginary_axis_crossings (the parameter
-// enters the structural block as q(mu) B, the family's stiffness_factor): PASS iff the lowest
-// crossing above min_crossing_fraction mu* is the boundary point itself.
+// Check: every jump, the first point past a skipped Mach number and the last point are tested
+// by imaginary_axis_crossings (the parameter enters the structural block as q(mu) B, the
+// family's stiffness_factor): PASS iff the lowest crossing above min_crossing_fraction mu* is
+// the boundary point itself.
 //
 // Moving equilibrium (moving_equilibrium: a mean incidence, the static deflection grows with
 // mu): every point is a full Hopf system; where a branch ends, the tracer hand-over (it assumes a
@@ -1202,15 +1203,23 @@ crossing_check_record check_flutter_crossing_scan(const F& family, int level, co
 }
 
 /// The points of a boundary whose lowest-crossing property is checked: the jumps (marked so, or
-/// structural cosine below same_mode_cosine to the previous point) and the last point.
+/// structural cosine below same_mode_cosine to the previous point), the first point past a
+/// skipped Mach number (continued across a Mach number without flutter, the branch it lands on
+/// need not be the lowest one) and the last point.
 template <flutter_family F>
 std::vector<std::pair<std::size_t, const char*>> flutter_check_points(const F& family, const flutter_boundary& b,
                                                                       double same_mode_cosine = 0.9) {
   std::vector<std::pair<std::size_t, const char*>> at;
   const auto& p = b.points;
-  for (std::size_t k = 1; k < p.size(); ++k)
+  for (std::size_t k = 1; k < p.size(); ++k) {
+    const bool across_skip = std::any_of(b.skipped.begin(), b.skipped.end(), [&](const auto& s) {
+      return s.first > p[k - 1].mach && s.first < p[k].mach;
+    });
     if (p[k].jump || structural_cosine(family, p[k - 1].point.p, p[k].point.p) < same_mode_cosine)
       at.emplace_back(k, "jump");
+    else if (across_skip)
+      at.emplace_back(k, "past a skipped Mach number");
+  }
   if (!p.empty() && (at.empty() || at.back().first != p.size() - 1)) at.emplace_back(p.size() - 1, "last point");
   return at;
 }
