@@ -14,6 +14,7 @@
 #include <aerohopf/reduction.hpp>
 #include <aerohopf/scalar/qd.hpp>
 #include <aerohopf/time/bdf2.hpp>
+#include <aerohopf/time/eigenmode_march.hpp>
 #include <aerohopf/time/history.hpp>
 
 #include <Eigen/Eigenvalues>
@@ -308,42 +309,49 @@ struct march_result {
   int peaks = 0;
 };
 
-/// BDF2 (dt = 0.125, 3 orders per step, frozen modified-order matrix, BILU(0)-GMRES) of system s
-/// at ubar from w0 to t_end; the plunge and pitch histories go to history_<tag>.csv.
-struct march_history {
-  std::vector<double> t, alpha;
-  long steps = 0, inner_iterations = 0;
-  double seconds = 0;
-};
-inline march_history march(const aerofoil_system& s, double ubar, const vec<double>& w0, double t_end, const std::string& tag,
-                    const options& o) {
-  bdf2_options bo;
-  bo.dt = 0.125;
-  bo.inner_residual_drop = 1e-3;  // three orders per real time step
-  bo.approximate_jacobian = true;  // modified-order Jacobian, frozen over the step (dual time)
-  bo.freeze_matrix = true;
-  bo.max_inner_iterations = 40;
+/// The inner solver of the BDF2 runs: BILU(0)-GMRES to 1e-2 (three orders per step need no more).
+inline krylov_solver<Eigen::SparseMatrix<double>, 4> bdf2_inner_solver() {
   krylov_solver_options ko;
   ko.fill_level = 0;
   ko.krylov.relative_tolerance = 1e-2;
   ko.krylov.max_iterations = 400;
   ko.krylov.record_history = false;
-  krylov_solver<Eigen::SparseMatrix<double>, 4> solver(ko, "BDF2 inner BILU(0)-GMRES");
+  return krylov_solver<Eigen::SparseMatrix<double>, 4>(ko, "BDF2 inner BILU(0)-GMRES");
+}
+
+/// Writes the plunge and pitch histories of a run to history_<tag>.csv, with progress.
+struct history_writer {
+  csv_writer csv;
+  std::string tag;
+  Eigen::Index ih, ia;
+  void operator()(const bdf2_step_info& i, const vec<double>& w) {
+    csv.row({i.t, w[ih], w[ia]});
+    if (i.step > 0 && i.step % 100 == 0)
+      std::printf("    %s: step %ld  t = %.2f  alpha = %+.5e  inner iterations %d\n", tag.c_str(), i.step, i.t, w[ia],
+                  i.inner_iterations);
+  }
+};
+inline history_writer history_to(const aerofoil_system& s, const std::string& tag, const options& o) {
+  return {csv_writer(o.out / ("history_" + tag + ".csv"), "t,h,alpha"), tag, s.flow_size(), s.flow_size() + 2};
+}
+
+/// BDF2 (dt = 0.125, cfd_bdf2_options) of system s at ubar from w0 to t_end: the pitch history.
+struct march_history {
+  std::vector<double> t, alpha;
+  double seconds = 0;
+};
+inline march_history march(const aerofoil_system& s, double ubar, const vec<double>& w0, double t_end,
+                           const std::string& tag, const options& o) {
+  auto solver = bdf2_inner_solver();
+  auto write = history_to(s, tag, o);
   march_history r;
-  const Eigen::Index ih = s.flow_size(), ia = s.flow_size() + 2;
-  csv_writer csv(o.out / ("history_" + tag + ".csv"), "t,h,alpha");
   const auto t0 = clk::now();
   integrate_bdf2(
-      s, ubar, w0, 0.0, t_end, bo,
+      s, ubar, w0, 0.0, t_end, cfd_bdf2_options(0.125),
       [&](const bdf2_step_info& i, const vec<double>& w) {
         r.t.push_back(i.t);
-        r.alpha.push_back(w[ia]);
-        csv.row({i.t, w[ih], w[ia]});
-        r.steps = i.step;
-        r.inner_iterations += i.inner_iterations;
-        if (i.step > 0 && i.step % 100 == 0)
-          std::printf("    %s: step %ld  t = %.2f  alpha = %+.5e  inner iterations %d\n", tag.c_str(), i.step, i.t,
-                      w[ia], i.inner_iterations);
+        r.alpha.push_back(w[write.ia]);
+        write(i, w);
       },
       solver);
   r.seconds = seconds_since(t0);
@@ -351,7 +359,8 @@ inline march_history march(const aerofoil_system& s, double ubar, const vec<doub
 }
 
 /// BDF2 run of the coupled system at Ubar = factor Ubar*, started on the critical eigenvector
-/// at that Ubar (pitch amplitude 0.01 rad), compared with the real part of that eigenvalue.
+/// at that Ubar (pitch amplitude 0.01 rad), its growth rate against the real part of that
+/// eigenvalue (march_eigenmode, dt = 0.125).
 inline march_result time_march(const structural_case& c, const grid_level& g, const flutter_boundary_point& bp, double factor,
                         double cycles, const options& o) {
   march_result r;
@@ -362,17 +371,21 @@ inline march_result time_march(const structural_case& c, const grid_level& g, co
   // the critical eigenpair at this Ubar (shift-invert from the Hopf eigenvalue)
   vec<cplx> p0 = bp.point.p.size() == s.size() ? bp.point.p : vec<cplx>();
   const eigen_pair ep = inverse_power(s.jacobian(st.w, r.ubar), cplx(0.0, bp.omega), {}, p0.size() ? &p0 : nullptr);
-  r.re_lambda = ep.lambda.real();
-  r.im_lambda = std::abs(ep.lambda.imag());
-  vec<cplx> v = ep.vector;
-  v *= 0.01 / v[s.flow_size() + 2];  // pitch component real, 0.01 rad
-  const vec<double> w0 = st.w + v.real();
+  eigenmode_march_options mo;
+  mo.coordinate = s.flow_size() + 2;  // the pitch angle
+  mo.amplitude = 0.01;
+  mo.cycles = cycles;
+  mo.dt = 0.125;
+  auto solver = bdf2_inner_solver();
   const std::string tag = c.name + "_" + g.name + "_M" + fixed(bp.mach, 2) + "_" + fixed(factor, 2);
-  const march_history h = march(s, r.ubar, w0, cycles * 2 * std::numbers::pi / bp.omega, tag, o);
-  r.steps = h.steps;
-  r.inner_iterations = h.inner_iterations;
-  r.seconds = h.seconds;
-  r.growth_rate = peak_growth_rate(h.t, h.alpha, 2 * std::numbers::pi / bp.omega, &r.peaks);
+  const eigenmode_march_result m = march_eigenmode(s, r.ubar, st.w, ep, mo, solver, history_to(s, tag, o));
+  r.re_lambda = m.re_lambda;
+  r.im_lambda = m.im_lambda;
+  r.steps = m.steps;
+  r.inner_iterations = m.inner_iterations;
+  r.seconds = m.seconds;
+  r.growth_rate = m.growth_rate;
+  r.peaks = m.peaks;
   return r;
 }
 
@@ -492,12 +505,16 @@ inline void reduced_part(const options& o, const boundaries& all) {
     if (std::abs(f - 0.97) < 1e-9 && o.verify) {
       // pitch amplitude 1e-4 rad: the LINEAR regime (at 0.01 rad the cubic term below adds
       // -0.0019 to the growth rate of this case, more than the linear damping itself)
-      vec<cplx> v = ep.vector;
-      v *= 1e-4 / v[ia];
-      const auto mh = march(s, ubar, (st.w + v.real()).eval(), (o.quick ? 3.0 : 4.0) * period,
-                            "heavy_coarse_M0.80_0.97_smoothed", o);
+      eigenmode_march_options mo;
+      mo.coordinate = ia;
+      mo.amplitude = 1e-4;
+      mo.cycles = 4.0;  // three leave one envelope sample after the 1.5-period transient
+      mo.dt = 0.125;
+      auto solver = bdf2_inner_solver();
+      const auto mh =
+          march_eigenmode(s, ubar, st.w, ep, mo, solver, history_to(s, "heavy_coarse_M0.80_0.97_smoothed", o));
       // mean envelope growth rate after the start transient (1.5 periods)
-      const auto env = amplitude_envelope(mh.t, mh.alpha, 1.5 * period);
+      const auto env = amplitude_envelope(mh.t, mh.y, 1.5 * period);
       growth = env.empty() ? NAN : 0.0;
       for (const auto& e : env) growth += e.growth_rate / double(env.size());
       std::printf("  time marching at %.2f Ubar*: growth rate %+.6f (%zu envelope samples, %.1f s)\n", f, growth,
