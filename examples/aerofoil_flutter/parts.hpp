@@ -303,10 +303,8 @@ inline int jump_check_part(const options& o, const boundaries& all) {
 // ---------------------------------------------------------------------------------------------
 // Part 3: time marching at 0.97 and 1.03 Ubar* (implicit BDF2, dual time, dt = 0.125).
 
-struct march_result {
-  double ubar = 0, growth_rate = 0, re_lambda = 0, im_lambda = 0, seconds = 0, steady_seconds = 0;
-  long steps = 0, inner_iterations = 0;
-  int peaks = 0;
+struct march_result : eigenmode_march_result {
+  double ubar = 0, steady_seconds = 0;
 };
 
 /// The inner solver of the BDF2 runs: BILU(0)-GMRES to 1e-2 (three orders per step need no more).
@@ -378,14 +376,7 @@ inline march_result time_march(const structural_case& c, const grid_level& g, co
   mo.dt = 0.125;
   auto solver = bdf2_inner_solver();
   const std::string tag = c.name + "_" + g.name + "_M" + fixed(bp.mach, 2) + "_" + fixed(factor, 2);
-  const eigenmode_march_result m = march_eigenmode(s, r.ubar, st.w, ep, mo, solver, history_to(s, tag, o));
-  r.re_lambda = m.re_lambda;
-  r.im_lambda = m.im_lambda;
-  r.steps = m.steps;
-  r.inner_iterations = m.inner_iterations;
-  r.seconds = m.seconds;
-  r.growth_rate = m.growth_rate;
-  r.peaks = m.peaks;
+  static_cast<eigenmode_march_result&>(r) = march_eigenmode(s, r.ubar, st.w, ep, mo, solver, history_to(s, tag, o));
   return r;
 }
 
