@@ -239,6 +239,10 @@ TEST(FlutterBoundary, BadInputIsRefused) {
   o.scan_delta = 0.5;  // wider than half the scan step: the check's last two values would not bracket mu*
   EXPECT_TRUE(test::contains(test::input_error_of([&] { trace_flutter_boundary(f, 8, {0.5}, nullptr, o); }),
                              "scan_delta 0.5"));
+  o = options_for(f, 1.66, 0.75, "bad");
+  o.start_eigen_tolerance = NAN;
+  EXPECT_TRUE(test::contains(test::input_error_of([&] { trace_flutter_boundary(f, 8, {0.5}, nullptr, o); }),
+                             "start_eigen_tolerance"));
 }
 
 }  // namespace
