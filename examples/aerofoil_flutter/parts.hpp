@@ -333,6 +333,20 @@ inline history_writer history_to(const aerofoil_system& s, const std::string& ta
   return {csv_writer(o.out / ("history_" + tag + ".csv"), "t,h,alpha"), tag, s.flow_size(), s.flow_size() + 2};
 }
 
+/// BDF2 (dt = 0.125) of system s at ubar from the equilibrium w plus the eigenmode ep scaled
+/// to a pitch amplitude (march_eigenmode on the pitch angle), writing history_<tag>.csv.
+inline eigenmode_march_result march_pitch_mode(const aerofoil_system& s, double ubar, const vec<double>& w,
+                                               const eigen_pair& ep, double amplitude, double cycles,
+                                               const std::string& tag, const options& o) {
+  eigenmode_march_options mo;
+  mo.coordinate = s.flow_size() + 2;  // the pitch angle
+  mo.amplitude = amplitude;
+  mo.cycles = cycles;
+  mo.dt = 0.125;
+  auto solver = bdf2_inner_solver();
+  return march_eigenmode(s, ubar, w, ep, mo, solver, history_to(s, tag, o));
+}
+
 /// BDF2 (dt = 0.125, cfd_bdf2_options) of system s at ubar from w0 to t_end: the pitch history.
 struct march_history {
   std::vector<double> t, alpha;
@@ -369,14 +383,8 @@ inline march_result time_march(const structural_case& c, const grid_level& g, co
   // the critical eigenpair at this Ubar (shift-invert from the Hopf eigenvalue)
   vec<cplx> p0 = bp.point.p.size() == s.size() ? bp.point.p : vec<cplx>();
   const eigen_pair ep = inverse_power(s.jacobian(st.w, r.ubar), cplx(0.0, bp.omega), {}, p0.size() ? &p0 : nullptr);
-  eigenmode_march_options mo;
-  mo.coordinate = s.flow_size() + 2;  // the pitch angle
-  mo.amplitude = 0.01;
-  mo.cycles = cycles;
-  mo.dt = 0.125;
-  auto solver = bdf2_inner_solver();
   const std::string tag = c.name + "_" + g.name + "_M" + fixed(bp.mach, 2) + "_" + fixed(factor, 2);
-  static_cast<eigenmode_march_result&>(r) = march_eigenmode(s, r.ubar, st.w, ep, mo, solver, history_to(s, tag, o));
+  static_cast<eigenmode_march_result&>(r) = march_pitch_mode(s, r.ubar, st.w, ep, 0.01, cycles, tag, o);
   return r;
 }
 
@@ -496,14 +504,8 @@ inline void reduced_part(const options& o, const boundaries& all) {
     if (std::abs(f - 0.97) < 1e-9 && o.verify) {
       // pitch amplitude 1e-4 rad: the LINEAR regime (at 0.01 rad the cubic term below adds
       // -0.0019 to the growth rate of this case, more than the linear damping itself)
-      eigenmode_march_options mo;
-      mo.coordinate = ia;
-      mo.amplitude = 1e-4;
-      mo.cycles = 4.0;  // three leave one envelope sample after the 1.5-period transient
-      mo.dt = 0.125;
-      auto solver = bdf2_inner_solver();
-      const auto mh =
-          march_eigenmode(s, ubar, st.w, ep, mo, solver, history_to(s, "heavy_coarse_M0.80_0.97_smoothed", o));
+      // four cycles: three leave one envelope sample after the 1.5-period transient
+      const auto mh = march_pitch_mode(s, ubar, st.w, ep, 1e-4, 4.0, "heavy_coarse_M0.80_0.97_smoothed", o);
       // mean envelope growth rate after the start transient (1.5 periods)
       const auto env = amplitude_envelope(mh.t, mh.y, 1.5 * period);
       growth = env.empty() ? NAN : 0.0;

@@ -43,12 +43,26 @@ inline long step_count(double t0, double t_end, double dt, const char* who) {
   require(std::isfinite(dt) && dt > 0, who, ": time step dt must be positive and finite (got ", dt, ")");
   return static_cast<long>(std::ceil((t_end - t0) / dt - 1e-9));
 }
+/// The extremum of the parabola through (t0, y0), (t1, y1), (t2, y2), t0 < t1 < t2 (steps need
+/// not be equal), its time clamped to [t0, t2]: (t1, y1) where the three are collinear.
+inline std::pair<double, double> parabolic_extremum(double t0, double t1, double t2, double y0, double y1, double y2) {
+  const double h1 = t1 - t0, h2 = t2 - t1;
+  const double d1 = (y1 - y0) / h1, d2 = (y2 - y1) / h2;
+  const double c2 = (d2 - d1) / (h1 + h2);  // y ~ y1 + b (s - t1) + c2 (s - t1)^2
+  const double b = d1 + c2 * h1;
+  if (c2 == 0.0) return {t1, y1};
+  const double ds = std::clamp(-b / (2.0 * c2), -h1, h2);
+  return {t1 + ds, y1 + b * ds + c2 * ds * ds};
+}
 }  // namespace internal
 
 /// Exponential growth rate of an oscillating signal: least-squares slope of log |y| against t
-/// over the local maxima of |y| (peaks of both signs) at t >= t_skip. For y ~ e^{sigma t}
-/// cos(omega t) it returns sigma (the real part of the mode's eigenvalue), independent of the
-/// phase. peaks (optional) receives the number of maxima used; fewer than two gives NaN.
+/// over the local maxima of |y| (peaks of both signs) at t >= t_skip, each refined by the
+/// parabola through its three samples of |y| (so the estimate is not limited by where the
+/// samples fall: at 20 samples per period a raw maximum errs by up to 1.2 % in amplitude). For
+/// y ~ e^{sigma t} cos(omega t) it returns sigma (the real part of the mode's eigenvalue),
+/// independent of the phase. peaks (optional) receives the number of maxima used; fewer than
+/// two gives NaN.
 inline double peak_growth_rate(const std::vector<double>& t, const std::vector<double>& y, double t_skip,
                                int* peaks = nullptr) {
   require(t.size() == y.size(), "peak_growth_rate: ", t.size(), " times for ", y.size(), " values");
@@ -56,13 +70,14 @@ inline double peak_growth_rate(const std::vector<double>& t, const std::vector<d
   int n = 0;
   for (std::size_t k = 1; k + 1 < y.size(); ++k) {
     if (t[k] < t_skip) continue;
-    const double a = std::abs(y[k]);
-    if (a > std::abs(y[k - 1]) && a >= std::abs(y[k + 1])) {
-      const double l = std::log(a);
-      sx += t[k];
+    const double a0 = std::abs(y[k - 1]), a1 = std::abs(y[k]), a2 = std::abs(y[k + 1]);
+    if (a1 > a0 && a1 >= a2) {
+      const auto [tp, ap] = internal::parabolic_extremum(t[k - 1], t[k], t[k + 1], a0, a1, a2);
+      const double l = std::log(ap);
+      sx += tp;
       sy += l;
-      sxx += t[k] * t[k];
-      sxy += t[k] * l;
+      sxx += tp * tp;
+      sxy += tp * l;
       ++n;
     }
   }
@@ -93,17 +108,7 @@ inline std::vector<amplitude_sample> amplitude_envelope(const std::vector<double
     if (t[k] < t_skip) continue;
     const bool is_max = y[k] > y[k - 1] && y[k] >= y[k + 1], is_min = y[k] < y[k - 1] && y[k] <= y[k + 1];
     if (!is_max && !is_min) continue;
-    // parabola through (t[k-1], t[k], t[k+1]); equal steps are not assumed
-    const double h1 = t[k] - t[k - 1], h2 = t[k + 1] - t[k];
-    const double d1 = (y[k] - y[k - 1]) / h1, d2 = (y[k + 1] - y[k]) / h2;
-    const double c2 = (d2 - d1) / (h1 + h2);  // y ~ y[k] + b (s - t[k]) + c2 (s - t[k])^2
-    const double b = d1 + c2 * h1;
-    double tk = t[k], yk = y[k];
-    if (c2 != 0.0) {
-      const double ds = std::clamp(-b / (2.0 * c2), -h1, h2);
-      tk += ds;
-      yk += b * ds + c2 * ds * ds;
-    }
+    const auto [tk, yk] = internal::parabolic_extremum(t[k - 1], t[k], t[k + 1], y[k - 1], y[k], y[k + 1]);
     te.push_back(tk);
     ye.push_back(yk);
   }
