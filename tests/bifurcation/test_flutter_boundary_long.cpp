@@ -6,7 +6,9 @@
 // Hopf solve from it. Checked: the jump point is a Hopf point of the full system whose static
 // deflection is that of a separate static aeroelastic solve; it agrees with the scan's zero of g;
 // the crossing checks (V-g scans from 0.5 Ubar*) pass. Then the skip of a listed Mach number
-// without a flutter point in the scan. Labelled long (about three minutes).
+// without a flutter point in the scan. Then the crossing direction of a Hopf point where g falls
+// through zero (medium grid), which the driver must not take for a flutter onset. Labelled long
+// (about four minutes).
 #include <aerohopf/bifurcation/flutter_boundary.hpp>
 #include <aerohopf/flow/naca_cgrid.hpp>
 #include <aerohopf/models/aerofoil_family.hpp>
@@ -65,6 +67,11 @@ TEST(FlutterBoundaryMoving, BranchEndJumpsByVgScanAtAlphaOneDegree) {
   const double alpha_static = w[w.size() - 2];
   EXPECT_NEAR(p.point.w[p.point.w.size() - 2], alpha_static, 1e-8);
   EXPECT_GT(alpha_static, 0.1);  // the section deflects by about 8.6 deg at this Ubar
+  // the first point (reached by the frozen-flow secant) is a flutter onset: Re(lambda) rises
+  // through zero there
+  const auto [below, above] = internal::moving_crossing_sides(f, f.system(4, 0.65), b.points[0].point, o);
+  EXPECT_LT(below, 0.0);
+  EXPECT_GT(above, 0.0);
   // the crossing checks: the jump and the last point (the same) pass
   ASSERT_FALSE(b.checks.empty());
   for (const auto& c : b.checks) EXPECT_TRUE(c.pass) << c.what << " at M = " << c.mach << ": lowest " << c.lowest_mu;
@@ -98,6 +105,35 @@ TEST(FlutterBoundaryMoving, MachWithoutFlutterInTheScanIsSkipped) {
   ASSERT_FALSE(b.checks.empty());
   EXPECT_EQ(b.checks.back().what, "past a skipped Mach number");
   for (const auto& c : b.checks) EXPECT_TRUE(c.pass) << c.what << " at M = " << c.mach << ": lowest " << c.lowest_mu;
+}
+
+// A Hopf point of the full system where g FALLS through zero: medium grid, M = 0.65, Ubar =
+// 1.5762689 (the frozen-flow secant led there from the point at M = 0.60). A V-g scan of the
+// equilibrium continued in steps of 0.01 Ubar from 0.5 Ubar (independent: the damping of the
+// tracked mode) has g = +0.0165 at 0.99 Ubar and -0.0068 at 1.01 Ubar, and the onset at 1.5221
+// where g rises. moving_crossing_sides must say falling, so the driver rejects such a point.
+TEST(FlutterBoundaryMoving, CrossingSidesOfARestabilisingHopfPoint) {
+  structure::pitch_plunge_parameters sp;
+  sp.mu_s = 10.0;
+  const aerofoil_family f(flow::naca_cgrid(), sp, {}, std::numbers::pi / 180);
+  flutter_boundary_options o = f.boundary_options();
+  o.label = "alpha1 sides";
+  const auto s = f.system(2, 0.65);
+  hopf_point h;
+  h.mu = 1.5762688604590065;
+  h.omega = 0.68823681668640457;
+  // the static aeroelastic equilibrium reached by a rising speed (pitch 0.0709 rad at Ubar*)
+  double u = 0.5 * h.mu;
+  h.w = f.static_equilibrium(s, u);
+  while (u < h.mu) {
+    const double next = std::min(u + 0.01 * h.mu, h.mu);
+    h.w = f.static_equilibrium_from(s, h.w, u, next);
+    u = next;
+  }
+  EXPECT_NEAR(h.w[h.w.size() - 2], 0.07093, 1e-4);
+  const auto [below, above] = internal::moving_crossing_sides(f, s, h, o);
+  EXPECT_GT(below, 0.0);
+  EXPECT_LT(above, 0.0);
 }
 
 }  // namespace

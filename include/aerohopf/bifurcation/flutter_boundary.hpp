@@ -147,6 +147,8 @@ struct flutter_boundary_options {
   /// Moving equilibrium: where the full Hopf Newton fails from the continued guess, the secant
   /// on the frozen-flow map (flutter_boundary_tracer::full_hopf): iterations and largest step
   /// (relative to mu). NACA 0012 coarse, alpha_0 = 1 deg, M = 0.60-0.6625: 3-5 iterations.
+  /// The point it leads to must be a flutter onset (moving_crossing_sides: Re(lambda) < 0 below,
+  /// > 0 above), else the attempt fails.
   int frozen_secant_iterations = 8;
   double frozen_secant_max_step = 0.05;
   /// Moving equilibrium: V-g scans (vg_diagram with the equilibrium continued along mu, the
@@ -368,9 +370,27 @@ moving_scan_result moving_vg_scan(const F& f, const typename F::system_type& s, 
     vec<double> w = w_first ? *w_first : f.equilibrium(s, mus.front());
     double mu_w = mus.front();
     r.equilibria[mu_w] = w;
+    // Continued from the last equilibrium; a step the solve fails on is split in halves, down
+    // to 1/8 (NACA 0012 medium, alpha_0 = 1 deg, M = 0.65: the static pitch doubles between
+    // 0.95 and 1.0 Ubar*, and Newton-Krylov met negative densities over a step of 0.03 Ubar*).
     auto equilibrium = [&](double mu) {
       if (const auto it = r.equilibria.find(mu); it != r.equilibria.end()) return it->second;
-      w = family_equilibrium_near(f, s, w, mu_w, mu);
+      const double from = mu_w;
+      for (int parts = 1;; parts *= 2) {
+        try {
+          vec<double> v = w;
+          double at = from;
+          for (int k = 1; k <= parts; ++k) {
+            const double next = k == parts ? mu : from + (mu - from) * k / parts;
+            v = family_equilibrium_near(f, s, v, at, next);
+            at = next;
+          }
+          w = std::move(v);
+          break;
+        } catch (const convergence_error&) {
+          if (parts >= 8) throw;
+        }
+      }
       mu_w = mu;
       r.equilibria[mu] = w;
       return w;
@@ -402,6 +422,32 @@ moving_scan_result moving_vg_scan(const F& f, const typename F::system_type& s, 
   }
   r.seconds = flutter_seconds_since(t0);
   return r;
+}
+
+/// The real parts of the critical eigenvalue just below and above a Hopf point h of a moving
+/// equilibrium, at (1 -+ scan_delta) |h.mu|: the equilibrium continued there from h.w
+/// (family_equilibrium_near), the eigenvalue nearest i h.omega by inverse power with BILU-GMRES
+/// (hopf_start_krylov) to the eigen-residual scan_tolerance. A flutter onset (g rising through
+/// zero) has below < 0 < above; a restabilisation the reverse.
+template <flutter_family F>
+std::pair<double, double> moving_crossing_sides(const F& f, const typename F::system_type& s, const hopf_point& h,
+                                                const flutter_boundary_options& o) {
+  constexpr int B = F::block_size;
+  require(h.w.size() == s.size(), o.label, ": crossing sides: the Hopf point's equilibrium has ", h.w.size(),
+          " entries for a system of ", s.size());
+  hopf_start_krylov_options so;
+  so.fill_level = o.fill_level;
+  so.krylov.restart = o.start_restart;
+  so.krylov.relative_tolerance = 0.1 * o.scan_tolerance;
+  so.inverse_power.tolerance = o.scan_tolerance;
+  const double mu = std::abs(h.mu);
+  auto re_at = [&](double m) {
+    const vec<double> w = family_equilibrium_near(f, s, h.w, mu, m);
+    eigen_pair ep;
+    hopf_start_krylov<B>(s, w, m, h.omega, so, &ep);
+    return ep.lambda.real();
+  };
+  return {re_at((1 - o.scan_delta) * mu), re_at((1 + o.scan_delta) * mu)};
 }
 
 /// The parameters of a V-g scan about mu (flutter_boundary_options::scan_from): scan_from to
@@ -579,7 +625,20 @@ class flutter_boundary_tracer {
       mu1 = mu2;
     }
     g.mu = mu1;
-    return solve_hopf_krylov<B>(s, g, ho, ko);
+    hopf_result h = solve_hopf_krylov<B>(s, g, ho, ko);
+    // The frozen-flow map leads to the Hopf point nearest its start, which can be one where g
+    // FALLS through zero (NACA 0012 medium, alpha_0 = 1 deg, M = 0.65: Ubar = 1.57627, above the
+    // onset at 1.5221 where g rises): not a flutter onset, so a failed attempt.
+    hopf_point q = h.point;
+    if (o_.parameter_even) q.mu = std::abs(q.mu);
+    const auto [below, above] = moving_crossing_sides(f_, s, q, o_);
+    flutter_say(log_, "    %s: Re(lambda) %+.3e at (1 - %g) mu*, %+.3e at (1 + %g) mu*\n", label.c_str(), below,
+                o_.scan_delta, above, o_.scan_delta);
+    if (!(below < 0 && above > 0))
+      throw convergence_error(concat(label, ": the Hopf point reached by the frozen-flow secant (mu = ", q.mu,
+                                     ", omega = ", q.omega, ") is no flutter onset: Re(lambda) = ", below, " at (1 - ",
+                                     o_.scan_delta, ") mu, ", above, " at (1 + ", o_.scan_delta, ") mu"));
+    return h;
   }
 
   /// The equilibrium at mu from w0, the one at mu0: the family's equilibrium_from where it has
