@@ -149,6 +149,43 @@ TEST(vg_diagram, tracked_start_vectors_name_the_modes) {
   EXPECT_GT(r.mode(0).front().overlap, 0.999);  // the start's shape is the exact one
 }
 
+// A tracked mode that moves fast past a fixed aerodynamic-like eigenvalue D = -0.15 + 0.76 i
+// (the same coupling T(mu) as two_mode_system, so D's eigenvector shares the tracked part):
+//   mode 0: lambda_0 = -0.1 + i (1 - 0.6 mu - 0.1 mu^2)
+// Steps of 0.25 and min_overlap 0 (only the inverse power's shift decides): from mu = 0.25 to
+// 0.5 the PREVIOUS eigenvalue (-0.1 + 0.844 i) is 0.098 from D and 0.169 from the mode's new
+// one, so an inverse power shifted there converges to D; the secant prediction (-0.1 + 0.688 i)
+// is 0.013 from the mode and 0.088 from D. The tracked eigenvalues must be the closed form's.
+struct distractor_system : two_mode_system {
+  static cplx lambda0(double mu) { return {-0.1, 1 - 0.6 * mu - 0.1 * mu * mu}; }
+  static Eigen::MatrixXd a(double mu) {
+    Eigen::MatrixXd d = Eigen::MatrixXd::Zero(6, 6);
+    const cplx l[2] = {lambda0(mu), cplx(-0.15, 0.76)};
+    for (int k = 0; k < 2; ++k) {
+      d(2 * k, 2 * k) = d(2 * k + 1, 2 * k + 1) = l[k].real();
+      d(2 * k, 2 * k + 1) = l[k].imag();
+      d(2 * k + 1, 2 * k) = -l[k].imag();
+    }
+    d(4, 4) = -2;
+    d(5, 5) = -3;
+    const Eigen::MatrixXd tm = t(mu);
+    return tm * d * tm.inverse();
+  }
+  vec<double> residual(const vec<double>& w, double mu) const { return a(mu) * w; }
+  jacobian_type jacobian(const vec<double>&, double mu) const { return a(mu); }
+};
+
+TEST(vg_diagram, tracks_from_the_secant_prediction_past_a_nearby_eigenvalue) {
+  const distractor_system sys;
+  vg_options o = two_mode_options();
+  o.min_overlap = 0.0;
+  const vg_result r = vg_diagram(sys, zero_state, {0.0, 0.25, 0.5, 0.75}, {{cplx(0, 1.0), {}}}, o);
+  ASSERT_TRUE(r.complete) << r.stop_reason;
+  ASSERT_EQ(r.points.size(), 4u);
+  for (const auto& p : r.points)
+    EXPECT_LT(std::abs(p.lambda - distractor_system::lambda0(p.mu)), 1e-8) << "mu " << p.mu << ": " << p.lambda;
+}
+
 // One listed step of 1.8 across the crossing: the overlap test (min_overlap 0.999) halves it
 // until the shapes agree, and the modes still come out right.
 TEST(vg_diagram, halves_a_step_whose_overlap_is_too_low) {
