@@ -159,7 +159,7 @@ struct flutter_boundary_options {
   /// flow eigenvalue, and inverse power stalls), in steps of scan_lead_step up to scan_fine_from,
   /// then scan_step (0.02 throughout: NACA 0012 medium, alpha_0 = 1 deg, M = 0.65, steps of 0.05
   /// took flow eigenvalues whose structural parts overlap the mode's by 0.98-0.996 for it, and
-  /// the scan found no rising zero of g, where steps of 0.02 find the onset at Ubar = 1.520).
+  /// the scan found no rising zero of g, where steps of 0.02 find the onset, Ubar* = 1.5151).
   /// Where a branch
   /// ends (natural continuation fails down to 1/min_step_divisor), the next listed Mach number's
   /// lowest rising zero of g below scan_to x the last point's mu starts the jump's full Hopf
@@ -427,6 +427,17 @@ moving_scan_result moving_vg_scan(const F& f, const typename F::system_type& s, 
   return r;
 }
 
+/// Options of an inverse-power start by BILU-GMRES (hopf_start_krylov) to the eigen-residual
+/// `tolerance`, each GMRES solve 10x tighter, with the driver's BILU fill and GMRES restart.
+inline hopf_start_krylov_options krylov_start_options(const flutter_boundary_options& o, double tolerance) {
+  hopf_start_krylov_options so;
+  so.fill_level = o.fill_level;
+  so.krylov.restart = o.start_restart;
+  so.krylov.relative_tolerance = 0.1 * tolerance;
+  so.inverse_power.tolerance = tolerance;
+  return so;
+}
+
 /// The real parts of the critical eigenvalue just below and above a Hopf point h of a moving
 /// equilibrium, at (1 -+ scan_delta) |h.mu|: the equilibrium continued there from h.w
 /// (family_equilibrium_near), the eigenvalue nearest i h.omega by inverse power with BILU-GMRES
@@ -438,11 +449,7 @@ std::pair<double, double> moving_crossing_sides(const F& f, const typename F::sy
   constexpr int B = F::block_size;
   require(h.w.size() == s.size(), o.label, ": crossing sides: the Hopf point's equilibrium has ", h.w.size(),
           " entries for a system of ", s.size());
-  hopf_start_krylov_options so;
-  so.fill_level = o.fill_level;
-  so.krylov.restart = o.start_restart;
-  so.krylov.relative_tolerance = 0.1 * o.scan_tolerance;
-  so.inverse_power.tolerance = o.scan_tolerance;
+  const hopf_start_krylov_options so = krylov_start_options(o, o.scan_tolerance);
   const double mu = std::abs(h.mu);
   auto re_at = [&](double m) {
     const vec<double> w = family_equilibrium_near(f, s, h.w, mu, m);
@@ -529,14 +536,7 @@ class flutter_boundary_tracer {
     return ho;
   }
 
-  hopf_start_krylov_options start_options() const {
-    hopf_start_krylov_options so;
-    so.fill_level = o_.fill_level;
-    so.krylov.restart = o_.start_restart;
-    so.krylov.relative_tolerance = 0.1 * o_.start_eigen_tolerance;
-    so.inverse_power.tolerance = o_.start_eigen_tolerance;
-    return so;
-  }
+  hopf_start_krylov_options start_options() const { return krylov_start_options(o_, o_.start_eigen_tolerance); }
 
   void record(double m, const char* kind, std::string outcome, double seconds) {
     b_.attempts.push_back({m, kind, std::move(outcome), seconds});
@@ -631,7 +631,7 @@ class flutter_boundary_tracer {
     hopf_result h = solve_hopf_krylov<B>(s, g, ho, ko);
     // The frozen-flow map leads to the Hopf point nearest its start, which can be one where g
     // FALLS through zero (NACA 0012 medium, alpha_0 = 1 deg, M = 0.65: Ubar = 1.57627, above the
-    // onset at 1.5221 where g rises): not a flutter onset, so a failed attempt.
+    // onset at 1.5151 where g rises): not a flutter onset, so a failed attempt.
     hopf_point q = h.point;
     if (o_.parameter_even) q.mu = std::abs(q.mu);
     const auto [below, above] = moving_crossing_sides(f_, s, q, o_);

@@ -18,8 +18,10 @@
 // at most twice the last one; the previous eigenvalue at the first step): from the previous one,
 // a neighbouring aerodynamic eigenvalue can be nearer than the mode's own (NACA 0012 medium,
 // alpha_0 = 1 deg, M = 0.65, Ubar 0.55 -> 0.60 Ubar*: 0.043 against 0.061 away; from the secant
-// 0.058 against 0.017), and its structural part overlaps 0.98. The distinct eigenpairs found are
-// the candidates, and
+// 0.058 against 0.017), and its structural part overlaps 0.98. Where the step is long for the
+// mode's curvature the secant can overshoot onto a neighbour too (there, at 0.05 Ubar* steps
+// where the frequency levels off): the steps must be short against the eigenvalue spacing. The
+// distinct eigenpairs found are the candidates, and
 // each mode takes the candidate whose TRACKED PART (the structural unknowns of an aeroelastic
 // system: vg_options::tracked_offset / tracked_size) has the largest normalised overlap
 //     |s_prev^H s| / (||s_prev|| ||s||)
