@@ -15,11 +15,13 @@
 #include <aerohopf/reduction/derivative_products.hpp>
 #include <aerohopf/scalar.hpp>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <iostream>
 #include <limits>
 #include <random>
+#include <type_traits>
 
 using namespace aerohopf;
 using namespace aerohopf::flow;
@@ -203,6 +205,62 @@ TEST(aerofoil_system, loads_match_flow_force_integration) {
   EXPECT_NEAR(cla, -(fx * std::cos(0.1) + fy * std::sin(0.1)) * std::sin(0.02) +
                        (-fx * std::sin(0.1) + fy * std::cos(0.1)) * std::cos(0.02), 1e-12);
   EXPECT_NEAR(cma, cm, 1e-12);  // moment about the elastic axis is invariant under rotation about it
+}
+
+// The moved metrics (rotation of the rest metrics) against compute_metrics on the rigidly moved
+// points and speeds of rigid_motion.hpp: area vectors, volumes and swept volumes to rounding, in
+// double and with the derivatives of jet<double, 4> in the four structural unknowns.
+TEST(aerofoil_system, moved_metrics_equal_compute_metrics_on_the_moved_grid) {
+  const aerofoil_system s = make_system(0.7);
+  const vec<double> w = perturbed_state(s, 11);
+  using J = jet<double, 4>;
+  vec<J> wj(w.size());
+  for (Eigen::Index i = 0; i < w.size(); ++i) wj[i] = J(w[i]);
+  for (int j = 0; j < 4; ++j) wj[s.flow_size() + j] = J::variable(w[s.flow_size() + j], j);
+  const auto check = [&](const auto& got, const auto& ref, double scale, const char* what) {
+    EXPECT_NEAR(to_double(got), to_double(ref), 1e-13 * scale) << what;
+    if constexpr (std::is_same_v<std::decay_t<decltype(got)>, J>) {
+      for (int j = 0; j < 4; ++j) {
+        EXPECT_NEAR(got.derivative(j), ref.derivative(j), 1e-13 * scale) << what << " d/dx" << j;
+      }
+    }
+  };
+  const auto compare = [&](const auto& wv) {
+    using T = typename std::decay_t<decltype(wv)>::Scalar;
+    multiblock_points<T, 2> pts, spd;
+    coupling::rigid_grid_motion<T>(s.flow().grid().points, s.pose<T>(wv),
+                                   {s.structure().parameters().x_ea, s.structure().parameters().y_ea}, pts, &spd);
+    const auto ref = compute_metrics<T, 2>(pts, &spd);
+    const auto got = s.moved_metrics<T>(wv);
+    ASSERT_EQ(got.blocks.size(), ref.blocks.size());
+    double amax = 0, vmax = 0;
+    for (const auto& b : ref.blocks) {
+      for (const auto& v : b.volume) vmax = std::max(vmax, std::abs(to_double(v)));
+      for (int d = 0; d < 2; ++d)
+        for (const auto& n : b.normal[d]) amax = std::max({amax, std::abs(to_double(n[0])), std::abs(to_double(n[1]))});
+    }
+    for (std::size_t b = 0; b < ref.blocks.size(); ++b) {
+      ASSERT_EQ(got.blocks[b].volume.size(), ref.blocks[b].volume.size());
+      for (std::size_t k = 0; k < ref.blocks[b].volume.size(); ++k)
+        check(got.blocks[b].volume[k], ref.blocks[b].volume[k], vmax, "volume");
+      for (int d = 0; d < 2; ++d) {
+        ASSERT_EQ(got.blocks[b].normal[d].size(), ref.blocks[b].normal[d].size());
+        for (std::size_t k = 0; k < ref.blocks[b].normal[d].size(); ++k) {
+          check(got.blocks[b].normal[d][k][0], ref.blocks[b].normal[d][k][0], amax, "area x");
+          check(got.blocks[b].normal[d][k][1], ref.blocks[b].normal[d][k][1], amax, "area y");
+          // swept volume: |x_g| ~ alpha' 30 chords on the far field
+          check(got.blocks[b].speed[d][k], ref.blocks[b].speed[d][k], 30 * amax, "swept volume");
+        }
+      }
+    }
+  };
+  compare(w);
+  compare(wj);
+  // the swept volumes are not all zero (the test compares moving faces)
+  const auto m = s.moved_metrics<double>(w);
+  double qmax = 0;
+  for (const auto& q : m.blocks[0].speed[0]) qmax = std::max(qmax, std::abs(q));
+  EXPECT_GT(qmax, 1e-3);
 }
 
 // steady_equilibrium returns only equilibria of the COUPLED system: at non-zero incidence the

@@ -49,12 +49,17 @@ struct krylov_options {
   bool throw_on_failure = false;     ///< throw convergence_error instead of returning a failed report
   bool record_history = true;        ///< keep the residual history
   std::string context = "Krylov";    ///< prefix of error messages
-  /// GMRES: classical Gram-Schmidt twice (true) or once (false). Twice keeps the basis orthogonal
-  /// to rounding (as modified Gram-Schmidt); once halves the passes over the basis, which dominate
-  /// long cycles of cheap operators, and loses orthogonality only as the preconditioned operator's
-  /// conditioning demands: GMRES then converges later but never falsely, since every cycle ends
-  /// with the TRUE residual b - A x.
+  /// GMRES: classical Gram-Schmidt with a second pass where needed (true) or once (false). The
+  /// second pass keeps the basis orthogonal to rounding (as modified Gram-Schmidt); once halves
+  /// the passes over the basis, which dominate long cycles of cheap operators, and loses
+  /// orthogonality only as the preconditioned operator's conditioning demands: GMRES then
+  /// converges later but never falsely, since every cycle ends with the TRUE residual b - A x.
   bool reorthogonalize = true;
+  /// The second pass runs only where the first left less than this fraction of ||A M^-1 v_j||
+  /// (the Daniel-Gragg-Kaufman-Stewart test, "twice is enough": a vector that kept 1/sqrt(2) of
+  /// its norm is orthogonal to the basis to rounding after one pass; PETSc's CGS refinement "if
+  /// needed"). 1 gives the second pass always.
+  double reorthogonalization_threshold = 0.70710678118654752;
 };
 
 struct krylov_report {
@@ -71,7 +76,8 @@ struct krylov_report {
 };
 
 /// Throws input_error("<where>: <option> <value> must be ...") for an option out of range:
-/// tolerances finite and >= 0 (an infinite one accepts any x), restart >= 1, max_iterations >= 0.
+/// tolerances finite and >= 0 (an infinite one accepts any x), restart >= 1, max_iterations >= 0,
+/// reorthogonalization_threshold in [0, 1].
 inline void validate_krylov_options(const krylov_options& opt, std::string_view where) {
   require(std::isfinite(opt.relative_tolerance) && opt.relative_tolerance >= 0, where, ": relative_tolerance ",
           opt.relative_tolerance, " must be finite and >= 0");
@@ -79,6 +85,8 @@ inline void validate_krylov_options(const krylov_options& opt, std::string_view 
           opt.absolute_tolerance, " must be finite and >= 0");
   require(opt.restart >= 1, where, ": restart ", opt.restart, " must be >= 1");
   require(opt.max_iterations >= 0, where, ": max_iterations ", opt.max_iterations, " must be >= 0");
+  require(opt.reorthogonalization_threshold >= 0 && opt.reorthogonalization_threshold <= 1, where,
+          ": reorthogonalization_threshold ", opt.reorthogonalization_threshold, " must be in [0, 1]");
 }
 
 namespace internal {
@@ -172,7 +180,7 @@ struct krylov_state {
 
 }  // namespace internal
 
-/// Right-preconditioned restarted GMRES(m) (Arnoldi with classical Gram-Schmidt applied twice,
+/// Right-preconditioned restarted GMRES(m) (Arnoldi with classical Gram-Schmidt, twice where needed,
 /// complex Givens rotations). The solution update M^{-1}(V y) is formed once per cycle, so no preconditioned
 /// basis is stored (n (m+1) scalars of memory).
 template <class S, class Op, class Pre>
@@ -205,21 +213,25 @@ krylov_report gmres(const Op& a, const Pre& m_pre, const vec<S>& b, vec<S>& x, c
       z = v.col(j);
       st.pre(z, r);  // r used as scratch: M^{-1} v_j
       st.op(r, w);
-      {  // classical Gram-Schmidt applied twice (CGS2): as stable as modified Gram-Schmidt
-         // and two matrix-vector passes over the basis instead of j+1 dot/axpy pairs
+      real hn;
+      {  // classical Gram-Schmidt, the second pass where the first cancelled most of w (the DGKS
+         // test, krylov_options): as stable as modified Gram-Schmidt, and matrix-vector passes
+         // over the basis instead of j+1 dot/axpy pairs
         const auto vj = v.leftCols(j + 1);
         auto hj = hc.head(j + 1);
+        const real before = opt.reorthogonalize ? w.norm() : real(0);
         hj.noalias() = vj.adjoint() * w;
         w.noalias() -= vj * hj;
-        if (opt.reorthogonalize) {
+        hn = w.norm();
+        if (opt.reorthogonalize && !(hn > real(opt.reorthogonalization_threshold) * before)) {
           auto h2 = hc2.head(j + 1);
           h2.noalias() = vj.adjoint() * w;
           w.noalias() -= vj * h2;
           hj += h2;
+          hn = w.norm();
         }
         h.col(j).head(j + 1) = hj;
       }
-      const real hn = w.norm();
       for (int i = 0; i < j; ++i) {  // previous rotations
         const S t = cs(i) * h(i, j) + sn(i) * h(i + 1, j);
         h(i + 1, j) = -Eigen::numext::conj(sn(i)) * h(i, j) + cs(i) * h(i + 1, j);
