@@ -344,26 +344,26 @@ TEST(hopf_bordered_hostile, nan_residual_is_reported_with_the_last_good_iterate)
   ASSERT_TRUE(ra.report.converged);
   ASSERT_TRUE(rb.report.converged);
   ASSERT_GE(rb.report.iterations, 3);
-  // each residual evaluation is two taylor products: call 5 is the residual at iterate 2
+  // each residual evaluation is one jet pass (A p_r and A p_i): call 3 is the residual at iterate 2
   direct_solver<Eigen::MatrixXcd> lu;
   const auto check = [&](const std::string& m) {
     for (const char* part : {"injected bordered", "last accepted iterate", "||F|| = ", "mu = ", "omega = "})
       EXPECT_NE(m.find(part), std::string::npos) << part << " not in: " << m;
   };
   try {
-    solve_hopf_bordered(faulty_system(d, 5), g, o, lu);
+    solve_hopf_bordered(faulty_system(d, 3), g, o, lu);
     ADD_FAILURE() << "bordered: no exception";
   } catch (const convergence_error& e) {
     check(e.what());
   }
   try {
-    solve_hopf_krylov<2>(faulty_system(sp, 5), g, o);
+    solve_hopf_krylov<2>(faulty_system(sp, 3), g, o);
     ADD_FAILURE() << "krylov: no exception";
   } catch (const convergence_error& e) {
     check(e.what());
   }
   o.newton.throw_on_failure = false;
-  const hopf_result bad = solve_hopf_krylov<2>(faulty_system(sp, 5), g, o);
+  const hopf_result bad = solve_hopf_krylov<2>(faulty_system(sp, 3), g, o);
   EXPECT_FALSE(bad.report.converged);
   check(bad.report.reason);
   ASSERT_TRUE(bad.point.p.allFinite() && std::isfinite(bad.point.mu) && std::isfinite(bad.point.omega));
@@ -527,20 +527,20 @@ TEST(hopf_bordered_full, full_formulation_hostile_input) {
   hopf_point bad = g;
   bad.w[1] = NAN;
   EXPECT_THROW(solve_hopf_krylov<2>(sp, bad, full_options(), full_krylov()), input_error);
-  // a NaN residual inside the run (call 17: 3 calls per residual of F, 5 per step with f_mu and
-  // the four differenced second-derivative passes, so the residual at iterate 2): the last
-  // accepted iterate is named, or returned
+  // a NaN residual inside the run (call 15: 2 calls per residual of F, f and one jet pass for
+  // A p_r and A p_i; 5 per step with f_mu and the four differenced second-derivative passes, so
+  // the residual at iterate 2): the last accepted iterate is named, or returned
   hopf_options o = full_options();
   o.label = "injected full";
   try {
-    solve_hopf_krylov<2>(faulty_system(sp, 17), g, o, full_krylov());
+    solve_hopf_krylov<2>(faulty_system(sp, 15), g, o, full_krylov());
     ADD_FAILURE() << "no exception";
   } catch (const convergence_error& e) {
     EXPECT_NE(std::string(e.what()).find("last accepted iterate"), std::string::npos) << e.what();
     EXPECT_NE(std::string(e.what()).find("injected full"), std::string::npos) << e.what();
   }
   o.newton.throw_on_failure = false;
-  const hopf_result r = solve_hopf_krylov<2>(faulty_system(sp, 17), g, o, full_krylov());
+  const hopf_result r = solve_hopf_krylov<2>(faulty_system(sp, 15), g, o, full_krylov());
   EXPECT_FALSE(r.report.converged);
   EXPECT_TRUE(r.point.w.allFinite() && r.point.p.allFinite());
   // hopf_start_krylov input checks
@@ -572,14 +572,14 @@ TEST(hopf_bordered_full, small_moving_equilibrium_bordered_direct) {
   hopf_options o = full_options();
   o.label = "injected bordered full";
   try {
-    solve_hopf_bordered(faulty_system(d, 17), g, o, lu);
+    solve_hopf_bordered(faulty_system(d, 15), g, o, lu);
     ADD_FAILURE() << "no exception";
   } catch (const convergence_error& e) {
     EXPECT_NE(std::string(e.what()).find("last accepted iterate"), std::string::npos) << e.what();
     EXPECT_NE(std::string(e.what()).find("injected bordered full"), std::string::npos) << e.what();
   }
   o.newton.throw_on_failure = false;
-  const hopf_result bad = solve_hopf_bordered(faulty_system(d, 17), g, o, lu);
+  const hopf_result bad = solve_hopf_bordered(faulty_system(d, 15), g, o, lu);
   EXPECT_FALSE(bad.report.converged);
   EXPECT_TRUE(bad.point.w.allFinite() && bad.point.p.allFinite());
   const hopf_result again = solve_hopf_bordered(d, bad.point, full_options(), lu);

@@ -388,8 +388,9 @@ class hopf_problem {
     const double m = mu(y), om = omega(y);
     vec<double> f(unknowns());
     if (!fixed_) f.head(n_) = sys_->residual(wy, m);
-    f.segment(off_, n_) = jacobian_product(*sys_, wy, m, pr) + om * pi;
-    f.segment(off_ + n_, n_) = jacobian_product(*sys_, wy, m, pi) - om * pr;
+    const auto [apr, api] = jacobian_product_pair(*sys_, wy, m, pr, pi);
+    f.segment(off_, n_) = apr + om * pi;
+    f.segment(off_ + n_, n_) = api - om * pr;
     f[unknowns() - 2] = s_.dot(pr);
     f[unknowns() - 1] = s_.dot(pi) - 1.0;
     return f;

@@ -8,9 +8,9 @@
 //
 // In the notation of spec 02 the eigen-equations are G(p, mu, omega) = (A(mu) - i omega I) p = 0
 // with p = p_r + i p_i and the normalisation s^T p = i (s real, fixed). G is always evaluated
-// exactly and matrix-free (jacobian_product through the templated residual), so the converged
-// point is the exact Hopf point whatever L and the linear tolerance are; they change only the
-// rate of convergence.
+// exactly and matrix-free (jacobian_product_pair: A p_r and A p_i in one jet pass through the
+// templated residual), so the converged point is the exact Hopf point whatever L and the linear
+// tolerance are; they change only the rate of convergence.
 //
 //  * bordered_hopf_step: the block elimination of the border unknowns (and of the flow update in
 //    the full formulation), written once against a strategy that solves with A (real) and with

@@ -33,7 +33,7 @@
 // Derivatives: w and mu exactly as solve_hopf (exact Jacobian, jacobian_directional,
 // jacobian_d_mu, residual_d_mu); nu by central differences of the family,
 //   f_nu = (f(w, mu; nu + h) - f(w, mu; nu - h)) / 2h,  (A p)_nu likewise with the exact
-//   matrix-free products A p (taylor pass), h = nu_step or cbrt(eps) max(1, |nu|)
+//   matrix-free products A p (jacobian_product_pair), h = nu_step or cbrt(eps) max(1, |nu|)
 // (error O(h^2) ~ 1e-11 relative). They only enter J_G (the convergence rate), never G, so the
 // points satisfy the exact equations. family(nu) is called for the current nu (residual) and
 // for nu +/- h (Jacobian): three constructions per Newton iteration; each is cached.
@@ -314,8 +314,9 @@ struct hopf_curve_layout {
                   const std::array<double, 3>& c, double value, vec<double>& f) const {
     const double mu = x[imu], nu = x[inu], om = x[iom];
     const vec<double> pr = x.segment(ipr, n), pi = x.segment(ipi, n);
-    f.segment(ipr, n) = jacobian_product(sys, w, mu, pr) + om * pi;
-    f.segment(ipi, n) = jacobian_product(sys, w, mu, pi) - om * pr;
+    const auto [apr, api] = jacobian_product_pair(sys, w, mu, pr, pi);
+    f.segment(ipr, n) = apr + om * pi;
+    f.segment(ipi, n) = api - om * pr;
     f[imu] = s.dot(pr);
     f[inu] = s.dot(pi) - 1.0;
     f[iom] = c[0] * mu + c[1] * nu + c[2] * om - value;
@@ -619,8 +620,10 @@ class hopf_curve_corrector : hopf_curve_corrector_base<F> {
     const S& sp = system_at(plus_, nu + h);
     const S& sm = system_at(minus_, nu - h);
     const vec<double> f_nu = (vec<double>(sp.residual(w, mu)) - vec<double>(sm.residual(w, mu))) / (2 * h);
-    const vec<double> apr_nu = (jacobian_product(sp, w, mu, pr) - jacobian_product(sm, w, mu, pr)) / (2 * h);
-    const vec<double> api_nu = (jacobian_product(sp, w, mu, pi) - jacobian_product(sm, w, mu, pi)) / (2 * h);
+    const auto [apr_p, api_p] = jacobian_product_pair(sp, w, mu, pr, pi);
+    const auto [apr_m, api_m] = jacobian_product_pair(sm, w, mu, pr, pi);
+    const vec<double> apr_nu = (apr_p - apr_m) / (2 * h);
+    const vec<double> api_nu = (api_p - api_m) / (2 * h);
     const S& sys = system_at(cur_, nu);
     const M a = sys.jacobian(w, mu);
     const M amu = jacobian_d_mu(sys, w, mu);

@@ -17,7 +17,7 @@
 //              c.(y - y_pred) ]                     y = (mu, nu, omega),  c_j = t_j / sigma_j^2
 // (the fixed-equilibrium Hopf system of hopf_bordered.hpp at w = w0(nu), plus the pseudo-arclength row
 // in the scaled (mu, nu, omega) metric of hopf_curve.hpp). A p is evaluated exactly and matrix-
-// free (jacobian_product: a taylor pass through the residual), so every point satisfies the
+// free (jacobian_product_pair: one jet pass through the residual), so every point satisfies the
 // exact equations to the Newton tolerance, whatever the approximations below.
 //
 // Nested steady solve (w0(nu), the Newton-Krylov solve of equilibrium_krylov.hpp): Newton on
@@ -59,8 +59,8 @@
 // solve_hopf_krylov: eta = min(eta_max, max(||G||, 0.1 abs_tolerance / ||G||)).
 //
 // Cost per corrector iteration: one steady Newton solve at the new nu (1-3 iterations from the
-// linear extrapolation), one dw0/dnu solve, assembly of A, L, A_mu, one complex BILU(k), four
-// taylor products for G_nu, one GMRES on J.
+// linear extrapolation), one dw0/dnu solve, assembly of A, L, A_mu, one complex BILU(k), two
+// jet passes of the residual for G_nu, one GMRES on J.
 //
 // Joint corrector (fixed_equilibrium_hopf_curve_options::joint_equilibrium). The nested solve above
 // converges w0(nu) at every nu the corrector visits, though only the last one matters. The joint
@@ -604,8 +604,10 @@ class fixed_equilibrium_hopf_corrector : hopf_curve_corrector_base<F> {
     const S& sp = system_at(plus_, nu + h);
     const S& sm = system_at(minus_, nu - h);
     const vec<double> wp = w + h * dw_nu, wm = w - h * dw_nu;
-    const vec<double> gr = (jacobian_product(sp, wp, mu, pr) - jacobian_product(sm, wm, mu, pr)) / (2 * h);
-    const vec<double> gi = (jacobian_product(sp, wp, mu, pi) - jacobian_product(sm, wm, mu, pi)) / (2 * h);
+    const auto [apr_p, api_p] = jacobian_product_pair(sp, wp, mu, pr, pi);
+    const auto [apr_m, api_m] = jacobian_product_pair(sm, wm, mu, pr, pi);
+    const vec<double> gr = (apr_p - apr_m) / (2 * h);
+    const vec<double> gi = (api_p - api_m) / (2 * h);
     cilu_.compute(shifted(lb, C(0.0, om)));
     const real_split_shifted_operator<real_block> inner(a, om, n);
     const complex_preconditioner_split_form<block_ilu<C, B>> inner_pre(cilu_, n, padded_);
