@@ -539,6 +539,18 @@ TEST(hopf_bordered_full, full_formulation_hostile_input) {
     EXPECT_NE(std::string(e.what()).find("last accepted iterate"), std::string::npos) << e.what();
     EXPECT_NE(std::string(e.what()).find("injected full"), std::string::npos) << e.what();
   }
+  // a NaN in f_mu inside a step (call 17, the first of step 3): a failed step, not bad input
+  // to GMRES; and in a second-derivative pass of that step (call 18)
+  for (const long at : {17L, 18L}) {
+    try {
+      solve_hopf_krylov<2>(faulty_system(sp, at), g, o, full_krylov());
+      ADD_FAILURE() << "no exception, fault at call " << at;
+    } catch (const convergence_error& e) {
+      const std::string m = e.what();
+      EXPECT_NE(m.find(at == 17 ? "f_mu" : "second-derivative product"), std::string::npos) << m;
+      EXPECT_NE(m.find("last accepted iterate 2"), std::string::npos) << m;
+    }
+  }
   o.newton.throw_on_failure = false;
   const hopf_result r = solve_hopf_krylov<2>(faulty_system(sp, 15), g, o, full_krylov());
   EXPECT_FALSE(r.report.converged);

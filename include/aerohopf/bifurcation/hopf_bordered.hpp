@@ -374,12 +374,21 @@ vec<double> bordered_hopf_step(Strategy& st, const hopf_problem<S>& prob, const 
   mu_column << st.a_mu(pr), st.a_mu(pi);
   vec<double> dw0, dw1;
   if (!prob.fixed_equilibrium()) {
+    // the model's derivatives inside a step: non-finite is a failed step (convergence_error,
+    // newton.hpp names the last accepted iterate), not bad input to the linear solvers
+    const auto finite_or_fail = [it](const vec<double>& v, const char* what) {
+      if (!v.allFinite())
+        throw convergence_error(aerohopf::internal::concat(what, " is not finite at Newton iteration ", it));
+    };
     dw0 = st.solve_flow(vec<double>(-f.head(n)), "dw0 = -f", it);
-    dw1 = st.solve_flow(vec<double>(-residual_d_mu(sys, w, mu)), "dw1 = -f_mu", it);
+    const vec<double> f_mu = residual_d_mu(sys, w, mu);
+    finite_or_fail(f_mu, "f_mu (the residual's derivative in mu)");
+    dw1 = st.solve_flow(vec<double>(-f_mu), "dw1 = -f_mu", it);
     const auto t0 = hopf_clock::now();
     const auto [b0r, b0i] = second_derivative_pair(sys, w, mu, pr, pi, dw0, exact_second_derivatives);
     const auto [b1r, b1i] = second_derivative_pair(sys, w, mu, pr, pi, dw1, exact_second_derivatives);
     st.stats.residual_seconds += seconds_since(t0);
+    for (const vec<double>* b : {&b0r, &b0i, &b1r, &b1i}) finite_or_fail(*b, "a second-derivative product B(p, dw)");
     mu_column.head(n) += b1r;
     mu_column.tail(n) += b1i;
     rhs.head(n) -= b0r;
