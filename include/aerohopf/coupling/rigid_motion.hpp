@@ -23,14 +23,34 @@ struct rigid_pose {
   S h{}, h_dot{}, alpha{}, alpha_dot{};
 };
 
+/// R(alpha) applied to rest vectors (point offsets from the axis, edges, area vectors).
+template <class S>
+struct rigid_rotation {
+  S c, s;
+  explicit rigid_rotation(const S& alpha) {
+    using std::cos;
+    using std::sin;
+    c = cos(alpha);
+    s = sin(alpha);
+  }
+  std::array<S, 2> apply(const std::array<double, 2>& v) const { return {c * v[0] + s * v[1], c * v[1] - s * v[0]}; }
+};
+
+/// Throws input_error naming `who` if a component of the pose is not finite (a NaN pose gives a
+/// NaN grid whose metrics and residual are NaN without a word).
+template <class S>
+void require_finite_pose(const rigid_pose<S>& q, const char* who) {
+  require(std::isfinite(to_double(q.h)) && std::isfinite(to_double(q.h_dot)) && std::isfinite(to_double(q.alpha)) &&
+              std::isfinite(to_double(q.alpha_dot)),
+          who, ": pose is not finite (h ", to_double(q.h), ", h' ", to_double(q.h_dot), ", alpha ", to_double(q.alpha),
+          ", alpha' ", to_double(q.alpha_dot), ")");
+}
+
 /// Position of one rest point x0 under pose q about the elastic axis ea.
 template <class S>
 std::array<S, 2> rigid_position(const std::array<double, 2>& x0, const rigid_pose<S>& q, const std::array<double, 2>& ea) {
-  using std::cos;
-  using std::sin;
-  const S c = cos(q.alpha), s = sin(q.alpha);
-  const double dx = x0[0] - ea[0], dy = x0[1] - ea[1];
-  return {c * dx + s * dy + ea[0], -s * dx + c * dy + ea[1] + q.h};
+  const auto r = rigid_rotation<S>(q.alpha).apply({x0[0] - ea[0], x0[1] - ea[1]});
+  return {r[0] + ea[0], r[1] + ea[1] + q.h};
 }
 
 /// Grid speed at a moved point x.
@@ -49,10 +69,7 @@ void rigid_grid_motion(const flow::multiblock_points<double, 2>& rest, const rig
   // its dimensions would be moved only in part.
   const char* who = "rigid_grid_motion";
   require(std::isfinite(ea[0]) && std::isfinite(ea[1]), who, ": elastic axis (", ea[0], ", ", ea[1], ") is not finite");
-  require(std::isfinite(to_double(q.h)) && std::isfinite(to_double(q.h_dot)) && std::isfinite(to_double(q.alpha)) &&
-              std::isfinite(to_double(q.alpha_dot)),
-          who, ": pose is not finite (h ", to_double(q.h), ", h' ", to_double(q.h_dot), ", alpha ", to_double(q.alpha),
-          ", alpha' ", to_double(q.alpha_dot), ")");
+  require_finite_pose(q, who);
   for (std::size_t b = 0; b < rest.blocks.size(); ++b)
     require_size(rest.blocks[b].x.size(), rest.blocks[b].n_points(), who,
                  aerohopf::internal::concat("rest grid block ", b, " point list"));

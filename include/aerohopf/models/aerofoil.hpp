@@ -85,17 +85,23 @@ class aerofoil_system {
       f.sign = h.sign;
       f.cell0 = static_cast<Eigen::Index>(flow_.cell_offset(h.donor_block) + h.donor);
       f.cell1 = static_cast<Eigen::Index>(flow_.cell_offset(h.donor_block) + h.donor2);
-      f.arm = rest_face_arm(h.block, h.dir, h.face);
       walls_.push_back(f);
     }
     require(!walls_.empty(), "aerofoil_system: the flow grid has no wall faces to integrate loads over");
+    // mid-point of every rest face relative to the elastic axis (the moved metrics and the loads)
     const auto& rest = flow_.metrics();
     face_arm_.resize(rest.blocks.size());
     for (std::size_t b = 0; b < rest.blocks.size(); ++b)
       for (int d = 0; d < 2; ++d) {
         auto& arms = face_arm_[b][d];
         arms.resize(rest.blocks[b].normal[d].size());
-        for (std::size_t k = 0; k < arms.size(); ++k) arms[k] = rest_face_arm(static_cast<int>(b), d, k);
+        const auto& g = flow_.grid().points.blocks[b];
+        for (std::size_t k = 0; k < arms.size(); ++k) {
+          const auto corners = flow::internal::face_corners<2>(d, flow::unravel<2>(k, rest.blocks[b].face_dims(d)));
+          const auto& xa = g.at(corners[0]);
+          const auto& xb = g.at(corners[1]);
+          arms[k] = {0.5 * (xa[0] + xb[0]) - ea_[0], 0.5 * (xa[1] + xb[1]) - ea_[1]};
+        }
       }
   }
 
@@ -192,11 +198,8 @@ class aerofoil_system {
   template <class T>
   flow::grid_metrics<T, 2> moved_metrics(const vec<T>& w) const {
     const coupling::rigid_pose<T> q = pose<T>(w);
-    require(std::isfinite(to_double(q.h)) && std::isfinite(to_double(q.h_dot)) && std::isfinite(to_double(q.alpha)) &&
-                std::isfinite(to_double(q.alpha_dot)),
-            "aerofoil_system::moved_metrics: pose is not finite (h ", to_double(q.h), ", h' ", to_double(q.h_dot),
-            ", alpha ", to_double(q.alpha), ", alpha' ", to_double(q.alpha_dot), ")");
-    const rotation<T> rot(q.alpha);
+    coupling::require_finite_pose(q, "aerofoil_system::moved_metrics");
+    const coupling::rigid_rotation<T> rot(q.alpha);
     const auto& rest = flow_.metrics();
     flow::grid_metrics<T, 2> m;
     m.blocks.resize(rest.blocks.size());
@@ -230,7 +233,7 @@ class aerofoil_system {
   std::pair<T, T> load_coefficients(const vec<T>& w) const {
     require_size(w.size(), size(), "aerofoil_system::load_coefficients", "state");
     const auto m = moved_metrics<T>(w);
-    return loads<T>(m, rotation<T>(w[nf_ + 2]), w);
+    return loads<T>(m, coupling::rigid_rotation<T>(w[nf_ + 2]), w);
   }
 
   template <class T>
@@ -239,7 +242,7 @@ class aerofoil_system {
     const auto m = moved_metrics<T>(w);
     vec<T> r(size());
     flow_.template residual<T>(m, w.data(), r.data());
-    const auto [cl, cm] = loads<T>(m, rotation<T>(w[nf_ + 2]), w);
+    const auto [cl, cm] = loads<T>(m, coupling::rigid_rotation<T>(w[nf_ + 2]), w);
     Eigen::Matrix<T, 4, 1> ws;
     for (int i = 0; i < 4; ++i) ws[i] = w[nf_ + i];
     const auto rs = structure_.rate<T>(ws, cl, cm, mu);
@@ -333,33 +336,7 @@ class aerofoil_system {
     int block, dir, sign;
     std::size_t face;
     Eigen::Index cell0, cell1;  // wall cell and the next one inwards (global cell indices)
-    std::array<double, 2> arm;  // rest face mid-point - elastic axis
   };
-
-  /// R(alpha) of rigid_motion.hpp applied to rest vectors (area vectors, arms).
-  template <class T>
-  struct rotation {
-    T c, s;
-    explicit rotation(const T& alpha) {
-      using std::cos;
-      using std::sin;
-      c = cos(alpha);
-      s = sin(alpha);
-    }
-    std::array<T, 2> apply(const std::array<double, 2>& v) const {
-      return {c * T(v[0]) + s * T(v[1]), c * T(v[1]) - s * T(v[0])};
-    }
-  };
-
-  // mid-point of face (block, dir, k) of the rest grid, relative to the elastic axis
-  std::array<double, 2> rest_face_arm(int block, int dir, std::size_t k) const {
-    const auto p = flow::unravel<2>(k, flow_.metrics().blocks[block].face_dims(dir));
-    const auto corners = flow::internal::face_corners<2>(dir, p);
-    const auto& g = flow_.grid().points.blocks[block];
-    const auto& xa = g.at(corners[0]);
-    const auto& xb = g.at(corners[1]);
-    return {0.5 * (xa[0] + xb[0]) - ea_[0], 0.5 * (xa[1] + xb[1]) - ea_[1]};
-  }
 
   template <class T>
   static T pressure_of(const T* wc) {
@@ -370,11 +347,12 @@ class aerofoil_system {
 
   /// Load of one wall face: (dC_l, dC_m) per unit (p_w - p_inf) and the face's lever arm.
   template <class T>
-  std::pair<T, T> face_load_per_pressure(const flow::grid_metrics<T, 2>& m, const rotation<T>& rot,
+  std::pair<T, T> face_load_per_pressure(const flow::grid_metrics<T, 2>& m, const coupling::rigid_rotation<T>& rot,
                                          const wall_face& f) const {
     const auto& s = m.blocks[f.block].normal[f.dir][f.face];
     const T fx = T(2.0 * f.sign) * s[0], fy = T(2.0 * f.sign) * s[1];  // area outward from the fluid
-    const auto [rx, ry] = rot.apply(f.arm);  // moved mid-point - moved axis (x_ea, y_ea + h)
+    // moved mid-point - moved axis (x_ea, y_ea + h)
+    const auto [rx, ry] = rot.apply(face_arm_[f.block][f.dir][f.face]);
     const double a = flow_.conditions().alpha_rad;
     const T cl = fy * T(std::cos(a)) - fx * T(std::sin(a));
     const T cm = -(rx * fy - ry * fx);  // nose-up = clockwise
@@ -382,7 +360,8 @@ class aerofoil_system {
   }
 
   template <class T>
-  std::pair<T, T> loads(const flow::grid_metrics<T, 2>& m, const rotation<T>& rot, const vec<T>& w) const {
+  std::pair<T, T> loads(const flow::grid_metrics<T, 2>& m, const coupling::rigid_rotation<T>& rot,
+                        const vec<T>& w) const {
     const T pinf = T(flow_.conditions().pressure());
     T cl = T(0.0), cm = T(0.0);
     for (const auto& f : walls_) {
@@ -446,7 +425,7 @@ class aerofoil_system {
     // in the cell's nv unknowns.
     using cjet = jet<double, nv>;
     const auto m = moved_metrics<double>(w);
-    const rotation<double> rot(w[nf_ + 2]);
+    const coupling::rigid_rotation<double> rot(w[nf_ + 2]);
     const auto& minv = structure_.mass_inverse();
     const double pi = std::numbers::pi, mus = structure_.parameters().mu_s;
     const double kl = 2.0 / (pi * mus), km = 4.0 / (pi * mus);
@@ -513,7 +492,7 @@ class aerofoil_system {
   std::array<double, 2> ea_{};
   Eigen::Index nf_ = 0;
   std::vector<wall_face> walls_;
-  std::vector<std::array<std::vector<std::array<double, 2>>, 2>> face_arm_;  // rest_face_arm of every face
+  std::vector<std::array<std::vector<std::array<double, 2>>, 2>> face_arm_;  // rest face mid-point - axis, by block, axis
 };
 
 }  // namespace aerohopf::models
