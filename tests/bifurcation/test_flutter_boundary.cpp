@@ -1,7 +1,8 @@
 // trace_flutter_boundary (bifurcation/flutter_boundary.hpp) on the pitch-plunge NACA 0012
 // (models/aerofoil_family.hpp), against the boundaries the aerofoil example computed with its own
 // copy of the algorithm before it moved into the library (tests/data/aerofoil_boundaries), the
-// coarse-increment predictor against natural continuation without it, the crossing check, the
+// coarser-level bridge against the tracer's landing, the coarse-increment predictor against
+// natural continuation without it, the crossing check, the
 // cost figures as a pure function of the points, and bad input.
 #include <aerohopf/bifurcation/flutter_boundary.hpp>
 #include <aerohopf/flow/naca_cgrid.hpp>
@@ -118,12 +119,51 @@ TEST(FlutterBoundary, HeavyCoarseEqualsTheExamplesBoundary) {
   EXPECT_TRUE(std::any_of(b.points.begin(), b.points.end(), [](const flutter_boundary_point& p) { return p.jump; }));
   EXPECT_TRUE(std::any_of(b.points.begin(), b.points.end(), [](const flutter_boundary_point& p) { return !p.own_steady; }));
   EXPECT_TRUE(std::any_of(b.attempts.begin(), b.attempts.end(), [](const flutter_attempt& a) { return a.kind == "arclength"; }));
+  // before the hand-over, the bridge on the very coarse grid is tried and fails: there the branch
+  // ends near M = 0.824 (the boundary jumps to the other mode), so the sub-trace has no point of
+  // this mode at the stretch's start M = 0.82625; the tracer then takes over on this level
+  const auto bridge = std::find_if(b.attempts.begin(), b.attempts.end(),
+                                   [](const flutter_attempt& a) { return a.kind == std::string("coarser-level bridge"); });
+  ASSERT_NE(bridge, b.attempts.end());
+  EXPECT_EQ(bridge->outcome.rfind("failed: ", 0), 0u) << bridge->outcome;
+  EXPECT_LT(bridge - b.attempts.begin(),
+            std::find_if(b.attempts.begin(), b.attempts.end(), [](const flutter_attempt& a) { return a.kind == "arclength"; }) -
+                b.attempts.begin());
   // the crossing check: the jump and the last point are the lowest crossings of the imaginary axis
   ASSERT_EQ(b.checks.size(), 2u);
   EXPECT_EQ(b.checks.front().what, "jump");
   EXPECT_EQ(b.checks.back().what, "last point");
   EXPECT_TRUE(b.checks_passed());
   for (const auto& c : b.checks) EXPECT_NEAR(c.lowest_mu / c.mu, 1.0, 1e-5) << "M = " << c.mach;
+}
+
+// The coarser-level bridge (flutter_boundary_options::coarser_level_bridge) on the heavy medium
+// grid, M = 0.82 -> 0.83, no coarse boundary given: natural continuation stops at M = 0.825 (the
+// Hopf curve folds back in M near 0.826 and its mode turns, omega* 0.20 -> 0.40), the stretch is
+// traced on the coarse grid and the medium grid restarted at M = 0.83 from it. The point equals
+// the one the medium-grid tracer lands on (tests/data/aerofoil_boundaries, the example's
+// boundary before the driver moved into the library) to the Newton tolerance. About 6 s.
+TEST(FlutterBoundary, CoarserLevelBridgeLandsWhereTheTracerDoes) {
+  const auto f = family(100.0);
+  flutter_boundary_options o = options_for(f, 4.18, 0.211, "heavy medium bridge");
+  ASSERT_TRUE(o.coarser_level_bridge);
+  const flutter_boundary b = trace_flutter_boundary(f, 2, {0.82, 0.83}, nullptr, o);
+  ASSERT_TRUE(b.complete) << b.stop_reason;
+  ASSERT_GE(b.points.size(), 2u);
+  const auto bridge = std::find_if(b.attempts.begin(), b.attempts.end(),
+                                   [](const flutter_attempt& a) { return a.kind == "coarser-level bridge"; });
+  ASSERT_NE(bridge, b.attempts.end());
+  EXPECT_EQ(bridge->outcome.rfind("accepted", 0), 0u) << bridge->outcome;
+  EXPECT_TRUE(std::none_of(b.attempts.begin(), b.attempts.end(),
+                           [](const flutter_attempt& a) { return a.kind == std::string("arclength"); }));
+  const flutter_boundary_point& p = b.points.back();
+  EXPECT_NEAR(p.mach, 0.83, 1e-12);
+  // boundary_heavy_medium.csv at M = 0.83 (the tracer's landing)
+  EXPECT_NEAR(p.mu / 4.5785485659128335, 1.0, 3e-5);
+  EXPECT_NEAR(p.omega / 0.39513228340412276, 1.0, 3e-5);
+  // the restart is the branch's continuation through the turned mode, not a jump
+  EXPECT_FALSE(p.jump);
+  EXPECT_LT(p.cosine, o.same_mode_cosine);
 }
 
 // Grid sequencing (very coarse -> coarse) and the coarse-increment predictor change the starts

@@ -9,6 +9,7 @@
 
 #include <cmath>
 #include <numbers>
+#include <optional>
 
 #include "../support/error_messages.hpp"
 
@@ -36,7 +37,13 @@ TEST(AerofoilFamily, LevelsAreStridesOfTheFineGrid) {
   EXPECT_EQ(aerofoil_family::level_name(4), "coarse");
   EXPECT_TRUE(f.refines(8, 4));
   EXPECT_FALSE(f.refines(8, 2));
+  // the coarser-level bridge's next level: twice the stride, none below the very coarse grid
+  EXPECT_EQ(f.coarser_level(2), std::optional<int>(4));
+  EXPECT_EQ(f.coarser_level(4), std::optional<int>(8));
+  EXPECT_FALSE(f.coarser_level(8).has_value());
+  EXPECT_TRUE(f.refines(*f.coarser_level(1), 1));
   EXPECT_TRUE(test::contains(test::input_error_of([&] { (void)f.system(0, 0.5); }), "stride"));
+  EXPECT_TRUE(test::contains(test::input_error_of([&] { (void)f.coarser_level(0); }), "stride"));
 }
 
 TEST(AerofoilFamily, StaticEquilibriumAtIncidenceIsPathIndependent) {
