@@ -22,6 +22,20 @@ using aerohopf::models::aerofoil_family;
 
 namespace {
 
+/// The static aeroelastic equilibrium of s at Ubar = to, continued from the one solved at `from`
+/// in steps of at most `step` (the equilibrium at incidence is not unique: the branch reached by a
+/// rising speed).
+vec<double> static_equilibrium_continued(const aerofoil_family& f, const models::aerofoil_system& s, double from,
+                                         double to, double step) {
+  vec<double> w = f.static_equilibrium(s, from);
+  for (double u = from; u < to;) {
+    const double next = std::min(u + step, to);
+    w = f.static_equilibrium_from(s, w, u, next);
+    u = next;
+  }
+  return w;
+}
+
 TEST(FlutterBoundaryMoving, BranchEndJumpsByVgScanAtAlphaOneDegree) {
   structure::pitch_plunge_parameters sp;
   sp.mu_s = 10.0;
@@ -58,12 +72,7 @@ TEST(FlutterBoundaryMoving, BranchEndJumpsByVgScanAtAlphaOneDegree) {
   // one at Ubar = 1 in steps of 0.05 (the equilibrium is not unique there: Newton from the section
   // at rest straight at Ubar*, or from Ubar = 1 in one step, lands on another branch, alpha =
   // -0.052 rad)
-  vec<double> w = f.static_equilibrium(s, 1.0);
-  for (double u = 1.0; u < p.mu;) {
-    const double next = std::min(u + 0.05, p.mu);
-    w = f.static_equilibrium_from(s, w, u, next);
-    u = next;
-  }
+  const vec<double> w = static_equilibrium_continued(f, s, 1.0, p.mu, 0.05);
   const double alpha_static = w[w.size() - 2];
   EXPECT_NEAR(p.point.w[p.point.w.size() - 2], alpha_static, 1e-8);
   EXPECT_GT(alpha_static, 0.1);  // the section deflects by about 8.6 deg at this Ubar
@@ -123,13 +132,7 @@ TEST(FlutterBoundaryMoving, CrossingSidesOfARestabilisingHopfPoint) {
   h.mu = 1.5762688604590065;
   h.omega = 0.68823681668640457;
   // the static aeroelastic equilibrium reached by a rising speed (pitch 0.0709 rad at Ubar*)
-  double u = 0.5 * h.mu;
-  h.w = f.static_equilibrium(s, u);
-  while (u < h.mu) {
-    const double next = std::min(u + 0.01 * h.mu, h.mu);
-    h.w = f.static_equilibrium_from(s, h.w, u, next);
-    u = next;
-  }
+  h.w = static_equilibrium_continued(f, s, 0.5 * h.mu, h.mu, 0.01 * h.mu);
   EXPECT_NEAR(h.w[h.w.size() - 2], 0.07093, 1e-4);
   const auto [below, above] = internal::moving_crossing_sides(f, s, h, o);
   EXPECT_GT(below, 0.0);
