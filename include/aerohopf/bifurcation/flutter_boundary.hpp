@@ -931,6 +931,9 @@ std::optional<flutter_boundary_point> flutter_boundary_tracer<F>::coarser_level_
     so.start_omega = from.omega;
     so.check_crossings = false;
     so.label = o_.label + " [" + f_.level_name(*lc) + " bridge]";
+    // a user's steady start takes only M, so it is one of this level's states: the sub-trace's
+    // tracer gets the family's equilibrium on its own level instead (arclength_bridge)
+    so.fixed_equilibrium.equilibrium_start = nullptr;
     const std::vector<double> ms = {from.mach, mach};
     flutter_boundary cb;
     try {
