@@ -918,10 +918,11 @@ std::optional<flutter_boundary_point> flutter_boundary_tracer<F>::coarser_level_
     const auto t0 = clk::now();
     const std::string what = concat("bridge on the ", f_.level_name(*lc), " level from M = ", flutter_fixed(from.mach, 5),
                                     " to M = ", flutter_fixed(mach, 4));
+    double flow_seconds = 0;  // this level's steady solve at mach: the unit of cost, never charged
     auto fail = [&](const std::string& why) -> std::optional<flutter_boundary_point> {
       flutter_say(log_, "    %s: %s failed: %s\n", o_.label.c_str(), what.c_str(), why.c_str());
       record(mach, "coarser-level bridge", "failed: " + why, flutter_seconds_since(t0));
-      rejected_ += flutter_seconds_since(t0);
+      rejected_ += flutter_seconds_since(t0) - flow_seconds;
       return std::nullopt;
     };
     flutter_say(log_, "    %s: %s (start: inverse power at mu = %.5f, omega = %.5f)\n", o_.label.c_str(), what.c_str(),
@@ -952,7 +953,9 @@ std::optional<flutter_boundary_point> flutter_boundary_tracer<F>::coarser_level_
     const flutter_boundary_point& c_end = cb.points.back();
     const S s = f_.system(level_, mach);
     const S sc = f_.system(*lc, mach);
+    const auto t_flow = clk::now();
     const solved_flow& st = flow_at(s, mach, c_end.mu);
+    flow_seconds = flutter_seconds_since(t_flow);
     hopf_point guess = c_end.point;
     guess.p = f_.prolong(s, sc, c_end.point.p);
     const std::string label = label_at(mach) + " (restart from the " + f_.level_name(*lc) + " bridge)";
@@ -961,7 +964,7 @@ std::optional<flutter_boundary_point> flutter_boundary_tracer<F>::coarser_level_
     const double c_end_cos = cosine(q->point, c_end.point);
     if (!(c_end_cos >= o_.same_mode_cosine))
       return fail(concat("the restart converged to another mode (structural cosine ", c_end_cos, " to the coarser point)"));
-    q->hopf_seconds = flutter_seconds_since(t0);
+    q->hopf_seconds = flutter_seconds_since(t0) - flow_seconds;
     record(mach, "coarser-level bridge", concat("accepted: ", cb.points.size(), " points on the coarser level"),
            q->hopf_seconds);
     return q;

@@ -160,8 +160,7 @@ class aerofoil_family {
   bool refines(int coarse_stride, int fine_stride) const { return coarse_stride == 2 * fine_stride; }
 
   /// The next coarser level (for flutter_boundary_options::coarser_level_bridge): twice the
-  /// stride, down to the very coarse grid (stride 8, 1,024 cells; stride 16 has 16 cells on the
-  /// aerofoil).
+  /// stride, down to the very coarse grid (stride 8: 256 cells; stride 16 would have 64).
   std::optional<int> coarser_level(int stride) const {
     require(stride >= 1, "aerofoil_family: grid stride ", stride, " must be >= 1");
     return 2 * stride <= 8 ? std::optional<int>(2 * stride) : std::nullopt;
