@@ -797,9 +797,12 @@ class flutter_boundary_tracer {
   std::optional<hopf_point> coarse_guess(const S& s, double m) const {
     const flutter_boundary_point* cp = coarse_at(m);
     if (!cp) return std::nullopt;
-    const S sc = f_.system(coarser_->level, m);
-    hopf_point guess = cp->point;
-    guess.p = f_.prolong(s, sc, cp->point.p);
+    return prolonged(s, *cp, coarser_->level);
+  }
+  /// The point cp of level `coarse` (at s's Mach number) as a start on s's level.
+  hopf_point prolonged(const S& s, const flutter_boundary_point& cp, int coarse) const {
+    hopf_point guess = cp.point;
+    guess.p = f_.prolong(s, f_.system(coarse, cp.mach), cp.point.p);
     return guess;
   }
 
@@ -952,12 +955,10 @@ std::optional<flutter_boundary_point> flutter_boundary_tracer<F>::coarser_level_
       if (cb.points[k].jump) return fail(concat("it jumps to another mode at M = ", cb.points[k].mach));
     const flutter_boundary_point& c_end = cb.points.back();
     const S s = f_.system(level_, mach);
-    const S sc = f_.system(*lc, mach);
     const auto t_flow = clk::now();
     const solved_flow& st = flow_at(s, mach, c_end.mu);
     flow_seconds = flutter_seconds_since(t_flow);
-    hopf_point guess = c_end.point;
-    guess.p = f_.prolong(s, sc, c_end.point.p);
+    const hopf_point guess = prolonged(s, c_end, *lc);
     const std::string label = label_at(mach) + " (restart from the " + f_.level_name(*lc) + " bridge)";
     auto q = hopf_at(s, mach, st, guess, label, "bridge restart");
     if (!q) return fail("the restart from its point at M = " + flutter_fixed(mach, 4) + " did not converge");
