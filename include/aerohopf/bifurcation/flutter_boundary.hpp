@@ -924,8 +924,9 @@ std::optional<flutter_boundary_point> flutter_boundary_tracer<F>::coarser_level_
     double flow_seconds = 0;  // this level's steady solve at mach: the unit of cost, never charged
     auto fail = [&](const std::string& why) -> std::optional<flutter_boundary_point> {
       flutter_say(log_, "    %s: %s failed: %s\n", o_.label.c_str(), what.c_str(), why.c_str());
-      record(mach, "coarser-level bridge", "failed: " + why, flutter_seconds_since(t0));
-      rejected_ += flutter_seconds_since(t0) - flow_seconds;
+      const double spent = flutter_seconds_since(t0) - flow_seconds;
+      record(mach, "coarser-level bridge", "failed: " + why, spent);
+      rejected_ += spent;
       return std::nullopt;
     };
     flutter_say(log_, "    %s: %s (start: inverse power at mu = %.5f, omega = %.5f)\n", o_.label.c_str(), what.c_str(),
