@@ -1,5 +1,6 @@
 // VTK output: the file parses back to the right numbers of points and cells, every cell
-// references valid points, and a free-stream field gives Cp = 0 and the free-stream Mach number.
+// references valid points, and a free-stream field gives Cp = 0 and the free-stream Mach number;
+// plate modes come back as written.
 #include <gtest/gtest.h>
 
 #include <aerohopf/flow/naca_cgrid.hpp>
@@ -73,4 +74,39 @@ TEST(vtk, refuses_non_finite_or_wrongly_sized_state_before_opening_the_file) {
   const vec<double> short_w = m.free_stream_vector().head(m.size() - 1);
   EXPECT_THROW(io::write_vtk<2>(path, m, short_w), input_error);
   EXPECT_FALSE(std::ifstream(path).good());
+}
+
+TEST(vtk, plate_modes_round_trip) {
+  using namespace aerohopf::structure;
+  const plate_mesh mesh = structured_plate_mesh(
+      4, 3, [](double s, double r) { return Eigen::Vector2d(s, 0.5 * r); }, [](double, double) { return 0.01; });
+  plate_constraints c(mesh.nodes.size());
+  for (int j = 0; j <= 3; ++j) c.clamp(5 * j);
+  const plate_modes md = plate_modes_of(mesh, isotropic_material(1e9, 0.3, 1000), c, {.count = 2});
+  const std::string path = ::testing::TempDir() + "/plate_modes.vtk";
+  io::write_vtk_plate_modes(path, mesh, md);
+  std::ifstream in(path);
+  std::string line, word;
+  std::size_t n = 0;
+  bool found = false;
+  while (std::getline(in, line)) {
+    if (line.rfind("POINTS", 0) == 0) {
+      std::istringstream(line) >> word >> n;
+      EXPECT_EQ(n, mesh.nodes.size());
+    }
+    if (line == "SCALARS mode_2_w double 1") {
+      found = true;
+      std::getline(in, line);  // lookup table
+      for (std::size_t i = 0; i < mesh.nodes.size(); ++i) {
+        double w = 0;
+        in >> w;
+        EXPECT_NEAR(w, md.shapes(static_cast<Eigen::Index>(3 * i), 1), 1e-10 * md.shapes.cwiseAbs().maxCoeff());
+      }
+      break;
+    }
+  }
+  EXPECT_TRUE(found) << "mode 2 deflection not in the file";
+  plate_modes bad = md;
+  bad.shapes.conservativeResize(bad.shapes.rows() - 3, Eigen::NoChange);
+  EXPECT_THROW(io::write_vtk_plate_modes(path, mesh, bad), input_error);
 }

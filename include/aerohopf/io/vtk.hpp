@@ -1,14 +1,16 @@
 #pragma once
-// Legacy-VTK output of a multi-block flow field for ParaView: all blocks in one UNSTRUCTURED_GRID
-// file (quads in 2D, hexahedra in 3D) with cell data density, velocity, pressure, Mach number
-// and Cp. Legacy ASCII is chosen because it needs no XML/base64 machinery and every ParaView
-// version reads it.
+// Legacy-VTK output for ParaView: a multi-block flow field (all blocks in one UNSTRUCTURED_GRID
+// file, quads in 2D, hexahedra in 3D, with cell data density, velocity, pressure, Mach number
+// and Cp), and a plate mesh with its structural modes (point data: thickness, each mode's
+// deflection as a scalar and as a displacement vector for ParaView's Warp By Vector). Legacy
+// ASCII is chosen because it needs no XML/base64 machinery and every ParaView version reads it.
 #include <fstream>
 #include <iomanip>
 #include <string>
 
 #include "../error.hpp"
 #include "../flow/euler_model.hpp"
+#include "../structure/plate_fe.hpp"
 
 namespace aerohopf::io {
 
@@ -82,6 +84,36 @@ void write_vtk(const std::string& path, const flow::euler_model<Dim>& m, const v
     out << q.u[0] << ' ' << q.u[1] << ' ' << (Dim == 3 ? q.u[Dim - 1] : 0.0) << '\n';
   }
   require(out.good(), "write_vtk: error while writing '", path, "'");
+}
+
+/// The plate mesh in its plane (z = 0) with point data thickness, mode_<k>_w (deflection of mode
+/// k, k from 1) and mode_<k> (displacement vector (0, 0, w)). Modes as plate_modes_of returns them
+/// (3 unknowns per node); checked before the file is opened.
+inline void write_vtk_plate_modes(const std::string& path, const structure::plate_mesh& mesh,
+                                  const structure::plate_modes& modes) {
+  const char* who = "write_vtk_plate_modes";
+  mesh.validate(who);
+  require_size(modes.shapes.rows(), mesh.unknowns(), who, "mode shapes (rows)");
+  require(modes.shapes.allFinite(), who, ": a mode shape is not finite");
+  std::ofstream out(path);
+  require(out.good(), who, ": cannot write '", path, "'");
+  const std::size_t np = mesh.nodes.size(), nc = mesh.quads.size();
+  out << "# vtk DataFile Version 3.0\naerohopf plate modes\nASCII\nDATASET UNSTRUCTURED_GRID\n";
+  out << "POINTS " << np << " double\n" << std::setprecision(12);
+  for (const auto& p : mesh.nodes) out << p.x() << ' ' << p.y() << " 0\n";
+  out << "CELLS " << nc << ' ' << nc * 5 << '\n';
+  for (const auto& q : mesh.quads) out << "4 " << q[0] << ' ' << q[1] << ' ' << q[2] << ' ' << q[3] << '\n';
+  out << "CELL_TYPES " << nc << '\n';
+  for (std::size_t c = 0; c < nc; ++c) out << "9\n";
+  out << "POINT_DATA " << np << "\nSCALARS thickness double 1\nLOOKUP_TABLE default\n";
+  for (double t : mesh.thickness) out << t << '\n';
+  for (Eigen::Index k = 0; k < modes.shapes.cols(); ++k) {
+    out << "SCALARS mode_" << k + 1 << "_w double 1\nLOOKUP_TABLE default\n";
+    for (std::size_t i = 0; i < np; ++i) out << modes.shapes(static_cast<Eigen::Index>(3 * i), k) << '\n';
+    out << "VECTORS mode_" << k + 1 << " double\n";
+    for (std::size_t i = 0; i < np; ++i) out << "0 0 " << modes.shapes(static_cast<Eigen::Index>(3 * i), k) << '\n';
+  }
+  require(out.good(), who, ": error while writing '", path, "'");
 }
 
 }  // namespace aerohopf::io
