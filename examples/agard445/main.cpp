@@ -12,12 +12,18 @@
 //                      largest deflection of 1 m, kg; the shapes are mass-normalised otherwise)
 //   mode_shapes.csv    mode,x,y,w  (x streamwise, y spanwise, m; w scaled to a largest |w| of 1)
 //   modes.vtk          the mesh with thickness and every mode (ParaView: Warp By Vector)
+//   modal_data.csv     the modes in the documented modal CSV (structure/modal_data.hpp)
+//   modes.bdf, modes.pch   the same as NASTRAN GRID* bulk data and punch eigenvectors
+// Both exchange formats are read back and compared with the modes written (exit status 1 if not).
 // plot_modes.py in this folder turns mode_shapes.csv into modes.png.
 #include <aerohopf/flow/wing_geometry.hpp>
 #include <aerohopf/io/csv.hpp>
+#include <aerohopf/io/nastran.hpp>
 #include <aerohopf/io/vtk.hpp>
+#include <aerohopf/structure/modal_data.hpp>
 #include <aerohopf/structure/plate_fe.hpp>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -170,9 +176,30 @@ int main(int argc, char** argv) try {
   structure::plate_modes written = chosen.modes;
   written.shapes.conservativeResize(Eigen::NoChange, o.modes);
   io::write_vtk_plate_modes((o.out / "modes.vtk").string(), chosen.mesh, written);
-  std::cout << "\nresults in " << o.out << " (modes.csv, mode_shapes.csv, modes.vtk; plot: python3 "
+
+  // the exchange formats, written and read back
+  const structure::modal_data md = structure::modal_data_from_plate(chosen.mesh, written);
+  structure::write_modal_csv(o.out / "modal_data.csv", md);
+  io::write_nastran_grid(o.out / "modes.bdf", md);
+  io::write_nastran_punch(o.out / "modes.pch", md);
+  auto worst_difference = [&](const structure::modal_data& r) {
+    double d = 0;
+    for (Eigen::Index k = 0; k < md.modes(); ++k) {
+      const Eigen::MatrixXd& a = md.shapes[static_cast<std::size_t>(k)];
+      d = std::max(d, std::abs(r.omega[k] / md.omega[k] - 1));
+      d = std::max(d, (r.shapes[static_cast<std::size_t>(k)] - a).cwiseAbs().maxCoeff() / a.cwiseAbs().maxCoeff());
+    }
+    return d;
+  };
+  const double d_csv = worst_difference(structure::read_modal_csv(o.out / "modal_data.csv"));
+  const double d_nas = worst_difference(io::read_nastran_modes(o.out / "modes.pch", o.out / "modes.bdf"));
+  const bool ok = d_csv <= 1e-14 && d_nas <= 1e-8;
+  std::printf("\nexchange formats read back: modal CSV differs by %.1e, NASTRAN punch by %.1e (relative): %s\n", d_csv,
+              d_nas, ok ? "PASS" : "FAIL");
+  std::cout << "results in " << o.out
+            << " (modes.csv, mode_shapes.csv, modes.vtk, modal_data.csv, modes.bdf, modes.pch; plot: python3 "
             << "examples/agard445/plot_modes.py " << o.out.string() << ")\n";
-  return 0;
+  return ok ? 0 : 1;
 } catch (const std::exception& e) {
   std::cerr << "agard445: " << e.what() << "\n";
   return 2;
