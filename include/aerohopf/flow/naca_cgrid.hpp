@@ -2,13 +2,11 @@
 // C-grid generator for NACA 4-digit aerofoils (sharp trailing edge), split into three blocks at
 // the trailing edge: lower wake, aerofoil, upper wake.
 //
-// Method (algebraic, normal marching): the inner C-curve (wake - lower surface - upper surface
-// - wake) is pushed outward layer by layer along its own normals with geometrically growing
-// steps (first step = first cell height, total = far-field distance). Normals are smoothed
-// with a number of averaging passes that grows with the layer, and points are redistributed
-// tangentially, so the lines stay orthogonal at the wall and fan out smoothly away from it
-// (concave corners such as the trailing edge cannot make lines cross). The wake cut is the
-// x-axis behind the trailing edge; the outflow boundary is the vertical line x = 1 + far field.
+// Method (algebraic, normal marching, grid_marching.hpp): the inner C-curve (wake - lower
+// surface - upper surface - wake) is pushed outward layer by layer along its own smoothed
+// normals with geometrically growing steps (first step = first cell height, total = far-field
+// distance). The wake cut is the x-axis behind the trailing edge; the outflow boundary is the
+// vertical line x = 1 + far field.
 //
 // Index convention: i runs from the lower wake outflow, upstream along the wake, round the
 // aerofoil clockwise (lower surface trailing edge to leading edge, then upper), and out along
@@ -21,6 +19,7 @@
 #include <vector>
 
 #include "../error.hpp"
+#include "grid_marching.hpp"
 #include "structured_grid.hpp"
 
 namespace aerohopf::flow {
@@ -58,20 +57,6 @@ inline std::array<double, 2> naca4_point(const std::string& digits, double x, bo
   const double s = upper ? 1.0 : -1.0;
   return {x - s * yt * std::sin(th), yc + s * yt * std::cos(th)};
 }
-
-namespace internal {
-/// Ratio r of a geometric sequence with first term h and n terms summing to total.
-inline double geometric_ratio(double h, int n, double total) {
-  require(h * n < total, "geometric_ratio: first spacing ", h, " times ", n, " exceeds ", total);
-  double lo = 1.0 + 1e-12, hi = 10.0;
-  for (int it = 0; it < 200; ++it) {
-    const double r = 0.5 * (lo + hi);
-    const double s = h * (std::pow(r, n) - 1.0) / (r - 1.0);
-    (s > total ? hi : lo) = r;
-  }
-  return 0.5 * (lo + hi);
-}
-}  // namespace internal
 
 /// The three-block C-grid with its topology. Wall patches carry the tag "aerofoil".
 inline multiblock_grid<2> naca_cgrid(const naca_cgrid_options& o = {}) {
@@ -131,73 +116,8 @@ inline multiblock_grid<2> naca_cgrid(const naca_cgrid_options& o = {}) {
   for (int k = 0; k <= nw; ++k) curve[ni - 1 - nw + k] = {wake_x[k], 0.0};
 
   // March outward.
-  const double r_normal = internal::geometric_ratio(o.first_height, nj - 1, o.far_field);
-  std::vector<std::vector<std::array<double, 2>>> layer(nj, curve);
-  std::vector<std::array<double, 2>> nrm(ni), tmp(ni);
-  for (int j = 1; j < nj; ++j) {
-    const auto& prev = layer[j - 1];
-    const double h = o.first_height * std::pow(r_normal, j - 1);
-    for (int i = 0; i < ni; ++i) {
-      const auto& a = prev[std::max(i - 1, 0)];
-      const auto& b = prev[std::min(i + 1, ni - 1)];
-      double tx = b[0] - a[0], ty = b[1] - a[1];
-      const double l = std::hypot(tx, ty);
-      nrm[i] = {-ty / l, tx / l};
-    }
-    nrm[0] = {0.0, -1.0};
-    nrm[ni - 1] = {0.0, 1.0};
-    // Implicit smoothing of the normals, (I - kappa_i delta^2) n_new = n, with kappa_i =
-    // (step / local spacing)^2: normals then vary slowly over one step length along the layer,
-    // so neighbouring lines cannot cross at concave corners, while near the wall (small
-    // steps) they stay almost exactly orthogonal.
-    {
-      // Thomas algorithm; rows 0 and ni-1 are fixed (Dirichlet), sub/super diagonals -kappa.
-      std::vector<double> cp(ni, 0.0), dx(ni), dy(ni);
-      for (int i = 1; i < ni - 1; ++i) {
-        const double ds = 0.5 * std::hypot(prev[i + 1][0] - prev[i - 1][0], prev[i + 1][1] - prev[i - 1][1]);
-        const double kap = o.smoothing * (h / ds) * (h / ds);
-        double rx = nrm[i][0], ry = nrm[i][1];
-        if (i == 1) {
-          rx += kap * nrm[0][0];
-          ry += kap * nrm[0][1];
-        }
-        if (i == ni - 2) {
-          rx += kap * nrm[ni - 1][0];
-          ry += kap * nrm[ni - 1][1];
-        }
-        const double m = 1.0 + 2.0 * kap + (i > 1 ? kap * cp[i - 1] : 0.0);
-        cp[i] = -kap / m;
-        dx[i] = (rx + (i > 1 ? kap * dx[i - 1] : 0.0)) / m;
-        dy[i] = (ry + (i > 1 ? kap * dy[i - 1] : 0.0)) / m;
-      }
-      for (int i = ni - 3; i >= 1; --i) {
-        dx[i] -= cp[i] * dx[i + 1];
-        dy[i] -= cp[i] * dy[i + 1];
-      }
-      for (int i = 1; i < ni - 1; ++i) {
-        const double l = std::hypot(dx[i], dy[i]);
-        nrm[i] = {dx[i] / l, dy[i] / l};
-      }
-    }
-    auto& cur = layer[j];
-    for (int i = 0; i < ni; ++i) cur[i] = {prev[i][0] + h * nrm[i][0], prev[i][1] + h * nrm[i][1]};
-    cur[0][0] = prev[0][0];
-    cur[ni - 1][0] = prev[ni - 1][0];
-    // Tangential redistribution: move each point along the layer towards the mid-point of its
-    // neighbours (tangential component only), more strongly away from the wall.
-    const double omega = std::min(0.5, 0.05 * j);
-    for (int s = 0; s < o.redistribution_passes; ++s) {
-      for (int i = 1; i < ni - 1; ++i) {
-        const double tx = cur[i + 1][0] - cur[i - 1][0], ty = cur[i + 1][1] - cur[i - 1][1];
-        const double l2 = tx * tx + ty * ty;
-        const double dx = 0.5 * (cur[i + 1][0] + cur[i - 1][0]) - cur[i][0];
-        const double dy = 0.5 * (cur[i + 1][1] + cur[i - 1][1]) - cur[i][1];
-        const double along = (dx * tx + dy * ty) / l2;
-        tmp[i] = {cur[i][0] + omega * along * tx, cur[i][1] + omega * along * ty};
-      }
-      for (int i = 1; i < ni - 1; ++i) cur[i] = tmp[i];
-    }
-  }
+  const auto layer = internal::march_c_layers(curve, {}, nj, o.first_height, o.far_field, o.smoothing,
+                                              o.redistribution_passes);
 
   multiblock_grid<2> g;
   const int i0[3] = {0, nw, nw + 2 * n_side};
