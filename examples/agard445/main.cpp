@@ -1,12 +1,17 @@
-// AGARD 445.6 weakened model 3 (spec 06): the structural modes from our own plate finite
-// elements (structure/plate_fe.hpp): the planform and NACA 65A004 thickness of
-// flow/wing_geometry.hpp, the orthotropic laminated mahogany with its fibre along the 45 deg
-// quarter-chord line, clamped root. Prints a mesh-convergence table of the first five frequencies
-// against Yates' calculated ones and the original work's FE model, and writes the modes.
+// AGARD 445.6 weakened model 3 (spec 06), the parts of the wing built so far:
+//  1. the structural modes from our own plate finite elements (structure/plate_fe.hpp): the
+//     planform and NACA 65A004 thickness of flow/wing_geometry.hpp, the orthotropic laminated
+//     mahogany with its fibre along the 45 deg quarter-chord line, clamped root; a mesh-convergence
+//     table of the first five frequencies against Yates' and the original work's;
+//  2. the C-H flow grids (flow/wing_grid.hpp): every level's size and cell quality, Plot3D files;
+//  3. the steady flow at M = 0.5, alpha = 0 and 1 deg on one level: CL, the lift slope against
+//     lifting-surface theory (vortex lattice, DATCOM), the wall Cp for ParaView.
 //
-// Usage: agard445 [out_dir] [--mesh NI,NJ] [--modes K]
+// Usage: agard445 [out_dir] [--mesh NI,NJ] [--modes K] [--steady LEVEL] [--fine-grid]
 //   --mesh NI,NJ   chordwise x spanwise quads of the modal mesh (default 24,24)
 //   --modes K      modes written (default 5)
+//   --steady L     level of the steady solutions: very_coarse, coarse (default), medium, none
+//   --fine-grid    also write the fine level's Plot3D file (1.5 M points, 37 MB)
 // Outputs under out_dir (default out/agard445):
 //   modes.csv          mode,frequency_hz,generalised_mass  (generalised mass of the mode scaled to a
 //                      largest deflection of 1 m, kg; the shapes are mass-normalised otherwise)
@@ -14,9 +19,18 @@
 //   modes.vtk          the mesh with thickness and every mode (ParaView: Warp By Vector)
 //   modal_data.csv     the modes in the documented modal CSV (structure/modal_data.hpp)
 //   modes.bdf, modes.pch   the same as NASTRAN GRID* bulk data and punch eigenvectors
+//   grid_<level>.xyz   Plot3D (binary, whole, 3D, one block) of very_coarse, coarse, medium (fine)
+//   grid_quality.csv   level,points,cells,wing_points,min_volume,min_corner_ratio,collinear_cells,tip_min_corner_ratio
+//   steady_<level>.csv mach,alpha_deg,cl,cd,steps,gmres_iterations,seconds (CL, CD on the half-wing area)
+//   lift_slope.csv     level,mach,euler_per_rad,vortex_lattice_per_rad,datcom_per_rad
+//   surface_<level>_M0.50_alpha1.vtk   the wing's wall Cp (ParaView)
 // Both exchange formats are read back and compared with the modes written (exit status 1 if not).
 // plot_modes.py in this folder turns mode_shapes.csv into modes.png.
+#include <aerohopf/flow/steady_solver.hpp>
+#include <aerohopf/flow/vortex_lattice.hpp>
 #include <aerohopf/flow/wing_geometry.hpp>
+#include <aerohopf/flow/wing_grid.hpp>
+#include <aerohopf/io/plot3d.hpp>
 #include <aerohopf/io/csv.hpp>
 #include <aerohopf/io/nastran.hpp>
 #include <aerohopf/io/vtk.hpp>
@@ -39,7 +53,17 @@ struct options {
   std::filesystem::path out = "out/agard445";
   int ni = 24, nj = 24;
   int modes = 5;
+  std::string steady = "coarse";
+  bool fine_grid = false;
 };
+
+int stride_of(const std::string& level) {
+  if (level == "very_coarse") return 8;
+  if (level == "coarse") return 4;
+  if (level == "medium") return 2;
+  if (level == "fine") return 1;
+  throw input_error("unknown grid level '" + level + "' (very_coarse, coarse, medium, fine)");
+}
 
 options parse(int argc, char** argv) {
   options o;
@@ -69,6 +93,11 @@ options parse(int argc, char** argv) {
         throw input_error("--modes takes an integer, not '" + v + "'");
       }
       require(o.modes >= 1 && o.modes <= 20, "--modes must lie in [1, 20] (got ", o.modes, ")");
+    } else if (a == "--steady") {
+      o.steady = next();
+      if (o.steady != "none") stride_of(o.steady);
+    } else if (a == "--fine-grid") {
+      o.fine_grid = true;
     } else if (!a.empty() && a[0] != '-') {
       o.out = a;
     } else {
@@ -196,8 +225,63 @@ int main(int argc, char** argv) try {
   const bool ok = d_csv <= 1e-14 && d_nas <= 1e-8;
   std::printf("\nexchange formats read back: modal CSV differs by %.1e, NASTRAN punch by %.1e (relative): %s\n", d_csv,
               d_nas, ok ? "PASS" : "FAIL");
-  std::cout << "results in " << o.out
-            << " (modes.csv, mode_shapes.csv, modes.vtk, modal_data.csv, modes.bdf, modes.pch; plot: python3 "
+
+  // 2. flow grids: the fine level, the others by coarsening (nested)
+  const flow::wing_grid_options go;
+  const flow::multiblock_grid<3> fine = flow::wing_cgrid(w, go);
+  std::printf("\nC-H flow grids (root chords; far field %.0f root chords; quality: corner det J / mean, "
+              "collinear = leading-edge cells of the cut beyond the tip)\n",
+              go.far_field);
+  std::printf("  %-12s %9s %9s %7s %10s %9s %9s %9s\n", "level", "points", "cells", "wing", "min vol", "min ratio",
+              "collinear", "tip ratio");
+  csv_writer quality(o.out / "grid_quality.csv",
+                     "level,points,cells,wing_points,min_volume,min_corner_ratio,collinear_cells,tip_min_corner_ratio");
+  for (const std::string level : {"very_coarse", "coarse", "medium", "fine"}) {
+    const int s = stride_of(level);
+    const flow::multiblock_grid<3> g = s == 1 ? fine : flow::coarsen(fine, s);
+    const flow::grid_quality q = flow::hexahedron_quality(g);
+    const int ks = go.span_cells / s, i0 = go.wake_cells / s, i1 = i0 + 2 * go.section_cells / s;
+    const flow::grid_quality t = flow::hexahedron_quality(g, 0, {i0, 0, ks - 2}, {i1, 2, ks + 2});
+    const auto wing_points = static_cast<long long>((i1 - i0 + 1) * (ks + 1));
+    const auto points = static_cast<long long>(g.points.blocks[0].n_points());
+    std::printf("  %-12s %9lld %9zu %7lld %10.2e %9.3f %9zu %9.3f\n", level.c_str(), points, q.cells, wing_points,
+                q.min_volume, q.min_corner_ratio, q.collinear_cells, t.min_corner_ratio);
+    quality.row({level, points, static_cast<long long>(q.cells), wing_points, q.min_volume, q.min_corner_ratio,
+                 static_cast<long long>(q.collinear_cells), t.min_corner_ratio});
+    if (s > 1 || o.fine_grid) io::write_plot3d<3>((o.out / ("grid_" + level + ".xyz")).string(), g.points, io::plot3d_format::binary);
+  }
+
+  // 3. steady flow at M = 0.5 and the lift slope
+  if (o.steady != "none") {
+    const int s = stride_of(o.steady);
+    const flow::multiblock_grid<3> g = s == 1 ? fine : flow::coarsen(fine, s);
+    const double mach = 0.5, area = w.planform.area() / (w.planform.root_chord * w.planform.root_chord);
+    csv_writer steady(o.out / ("steady_" + o.steady + ".csv"), "mach,alpha_deg,cl,cd,steps,gmres_iterations,seconds");
+    std::printf("\nsteady Euler, %s level, M = %.2f (CL, CD on the half-wing area)\n", o.steady.c_str(), mach);
+    double cl[2] = {0, 0};
+    for (int a = 0; a < 2; ++a) {
+      flow::euler_model<3> m(g, {.mach = mach, .alpha_rad = a * std::numbers::pi / 180}, {.force_tag = "wing"});
+      vec<double> st = m.free_stream_vector();
+      const flow::steady_report rep = flow::solve_steady<3>(m, st, {});
+      const auto f = m.forces(st);
+      cl[a] = f.cl / area;
+      std::printf("  alpha %d deg: CL %.5f  CD %.6f  (%d Newton steps, %d GMRES, ||R|| %.1e -> %.1e, %.1f s)\n", a, cl[a],
+                  f.cd / area, rep.steps, rep.linear_iterations, rep.initial_residual, rep.final_residual, rep.seconds);
+      steady.row({mach, static_cast<double>(a), cl[a], f.cd / area, static_cast<long long>(rep.steps),
+                  static_cast<long long>(rep.linear_iterations), rep.seconds});
+      if (a == 1) io::write_vtk_wall_surface((o.out / ("surface_" + o.steady + "_M0.50_alpha1.vtk")).string(), m, st);
+    }
+    const double euler = (cl[1] - cl[0]) * 180 / std::numbers::pi;
+    const double vlm = flow::vortex_lattice_lift_slope(w.planform, mach, 16, 48).lift_slope;
+    const double datcom = flow::datcom_lift_slope(w.planform, mach);
+    std::printf("  lift slope per radian: Euler %.4f, vortex lattice %.4f (Euler / VLM %.3f), DATCOM %.4f\n", euler, vlm,
+                euler / vlm, datcom);
+    csv_writer slope(o.out / "lift_slope.csv", "level,mach,euler_per_rad,vortex_lattice_per_rad,datcom_per_rad");
+    slope.row({o.steady, mach, euler, vlm, datcom});
+  }
+  std::cout << "\nresults in " << o.out
+            << " (modes.csv, mode_shapes.csv, modes.vtk, modal_data.csv, modes.bdf, modes.pch, grid_*.xyz, "
+               "grid_quality.csv, steady_*.csv, lift_slope.csv, surface_*.vtk; plot: python3 "
             << "examples/agard445/plot_modes.py " << o.out.string() << ")\n";
   return ok ? 0 : 1;
 } catch (const std::exception& e) {

@@ -1,9 +1,11 @@
 // VTK output: the file parses back to the right numbers of points and cells, every cell
 // references valid points, and a free-stream field gives Cp = 0 and the free-stream Mach number;
-// plate modes come back as written.
+// plate modes come back as written; a wing's wall surface has one quad per wall face with the
+// model's wall Cp.
 #include <gtest/gtest.h>
 
 #include <aerohopf/flow/naca_cgrid.hpp>
+#include <aerohopf/flow/wing_grid.hpp>
 #include <aerohopf/io/vtk.hpp>
 
 #include <cmath>
@@ -109,4 +111,38 @@ TEST(vtk, plate_modes_round_trip) {
   plate_modes bad = md;
   bad.shapes.conservativeResize(bad.shapes.rows() - 3, Eigen::NoChange);
   EXPECT_THROW(io::write_vtk_plate_modes(path, mesh, bad), input_error);
+}
+
+TEST(vtk, wing_wall_surface_has_every_wing_face) {
+  const auto g = coarsen(wing_cgrid(agard445_6()), 8);
+  euler_model<3> m(g, {.mach = 0.5, .alpha_rad = 0.02}, {.force_tag = "wing"});
+  const vec<double> w = m.free_stream_vector();
+  const std::string path = ::testing::TempDir() + "/wing_surface.vtk";
+  io::write_vtk_wall_surface(path, m, w);
+  std::ifstream in(path);
+  std::string line, word;
+  std::size_t cells = 0;
+  double cp_sum = 0;
+  while (std::getline(in, line)) {
+    if (line.rfind("CELLS", 0) == 0) std::istringstream(line) >> word >> cells;
+    if (line == "SCALARS cp double 1") {
+      std::getline(in, line);
+      for (std::size_t c = 0; c < cells; ++c) {
+        double v = 0;
+        in >> v;
+        cp_sum += v;
+      }
+      break;
+    }
+  }
+  const auto faces = m.wall_faces(w);
+  EXPECT_EQ(cells, faces.size());
+  const wing_grid_options o;
+  EXPECT_EQ(cells, static_cast<std::size_t>(2 * o.section_cells / 8 * o.span_cells / 8));
+  double want = 0;
+  for (const auto& f : faces) want += f.cp;
+  EXPECT_NEAR(cp_sum, want, 1e-9 * (1 + std::abs(want)));
+  vec<double> bad = w;
+  bad[3] = NAN;
+  EXPECT_THROW(io::write_vtk_wall_surface(path, m, bad), input_error);
 }

@@ -1,11 +1,12 @@
 #pragma once
 // Legacy-VTK output for ParaView: a multi-block flow field (all blocks in one UNSTRUCTURED_GRID
 // file, quads in 2D, hexahedra in 3D, with cell data density, velocity, pressure, Mach number
-// and Cp), and a plate mesh with its structural modes (point data: thickness, each mode's
+// and Cp), the wall surface of a 3D flow (quads with the wall pressure and Cp), and a plate mesh with its structural modes (point data: thickness, each mode's
 // deflection as a scalar and as a displacement vector for ParaView's Warp By Vector). Legacy
 // ASCII is chosen because it needs no XML/base64 machinery and every ParaView version reads it.
 #include <fstream>
 #include <iomanip>
+#include <map>
 #include <string>
 
 #include "../error.hpp"
@@ -113,6 +114,70 @@ inline void write_vtk_plate_modes(const std::string& path, const structure::plat
     out << "VECTORS mode_" << k + 1 << " double\n";
     for (std::size_t i = 0; i < np; ++i) out << "0 0 " << modes.shapes(static_cast<Eigen::Index>(3 * i), k) << '\n';
   }
+  require(out.good(), who, ": error while writing '", path, "'");
+}
+
+/// The walls of a 3D flow whose force tag is the model's (euler_options::force_tag; all walls if
+/// empty) as quads with cell data cp and pressure (the Osher star pressure of the wall flux,
+/// euler_model::wall_faces). Checked before the file is opened.
+inline void write_vtk_wall_surface(const std::string& path, const flow::euler_model<3>& m, const vec<double>& w) {
+  using namespace flow;
+  const char* who = "write_vtk_wall_surface";
+  require_size(w.size(), m.size(), who, "state");
+  require_finite(w, who, "state");
+  // wall_faces in a map by face centre (computed by the same function below: exact keys)
+  std::map<std::array<double, 3>, std::pair<double, double>> at;
+  for (const auto& f : m.wall_faces(w)) at[f.centre] = {f.cp, f.pressure};
+  const auto& g = m.grid();
+  const std::string& tag = m.options().force_tag;
+  struct quad {
+    std::array<std::array<double, 3>, 4> x;
+    double cp, p;
+  };
+  std::vector<quad> quads;
+  for (const auto& pt : g.topology.patches) {
+    if (pt.kind != boundary_kind::wall || (!tag.empty() && pt.tag != tag)) continue;
+    const auto& blk = g.points.blocks[static_cast<std::size_t>(pt.block)];
+    const int d = pt.face / 2, side = pt.face % 2, a = (d + 1) % 3, b = (d + 2) % 3;
+    const auto cells = blk.cells();
+    for (int u = pt.begin[a]; u < pt.end[a]; ++u)
+      for (int v = pt.begin[b]; v < pt.end[b]; ++v) {
+        index_d<3> p{};
+        p[d] = side ? cells[d] : 0;
+        p[a] = u;
+        p[b] = v;
+        const auto c = flow::internal::face_centre<double, 3>(blk, d, p);
+        const auto it = at.find(c);
+        require(it != at.end(), who, ": wall face of block ", pt.block, " at (", p[0], ", ", p[1], ", ", p[2],
+                ") not among the model's wall faces");
+        quad q;
+        for (int corner = 0; corner < 4; ++corner) {
+          index_d<3> r = p;
+          r[a] += corner == 1 || corner == 2;
+          r[b] += corner >= 2;
+          q.x[static_cast<std::size_t>(corner)] = blk.at(r);
+        }
+        q.cp = it->second.first;
+        q.p = it->second.second;
+        quads.push_back(q);
+      }
+  }
+  require(!quads.empty(), who, ": no wall faces", tag.empty() ? std::string() : " tagged '" + tag + "'");
+  std::ofstream out(path);
+  require(out.good(), who, ": cannot write '", path, "'");
+  out << "# vtk DataFile Version 3.0\naerohopf wall surface\nASCII\nDATASET UNSTRUCTURED_GRID\n";
+  out << "POINTS " << 4 * quads.size() << " double\n" << std::setprecision(12);
+  for (const auto& q : quads)
+    for (const auto& x : q.x) out << x[0] << ' ' << x[1] << ' ' << x[2] << '\n';
+  out << "CELLS " << quads.size() << ' ' << 5 * quads.size() << '\n';
+  for (std::size_t c = 0; c < quads.size(); ++c)
+    out << "4 " << 4 * c << ' ' << 4 * c + 1 << ' ' << 4 * c + 2 << ' ' << 4 * c + 3 << '\n';
+  out << "CELL_TYPES " << quads.size() << '\n';
+  for (std::size_t c = 0; c < quads.size(); ++c) out << "9\n";
+  out << "CELL_DATA " << quads.size() << "\nSCALARS cp double 1\nLOOKUP_TABLE default\n";
+  for (const auto& q : quads) out << q.cp << '\n';
+  out << "SCALARS pressure double 1\nLOOKUP_TABLE default\n";
+  for (const auto& q : quads) out << q.p << '\n';
   require(out.good(), who, ": error while writing '", path, "'");
 }
 
