@@ -30,6 +30,7 @@
 #include <string>
 #include <vector>
 
+#include "../common/cli.hpp"
 #include "setup.hpp"
 
 using namespace aerohopf;
@@ -69,24 +70,20 @@ int main(int argc, char** argv) {
   std::cout << std::unitbuf;
   options o;
   try {
-    for (int i = 1; i < argc; ++i) {
-      const std::string a = argv[i];
-      auto next = [&]() -> std::string {
-        require(i + 1 < argc, "option ", a, " needs a value");
-        return argv[++i];
-      };
-      if (a == "--grid") o.grid = level_named(next());
-      else if (a == "--case") o.scase = case_named(next());
-      else if (a == "--mach-min") o.mach_min = std::stod(next());
-      else if (a == "--mach-max") o.mach_max = std::stod(next());
-      else if (a == "--out") o.out = next();
-      else if (a == "--fill") o.fill = std::stoi(next());
-      else if (a == "--max-points") o.max_points = std::stoi(next());
-      else if (a == "--nu-scale") o.nu_scale = std::stod(next());
-      else if (a == "--mu-scale") o.mu_scale = std::stod(next());
-      else if (a == "--omega-scale") o.omega_scale = std::stod(next());
-      else if (a == "--max-step") o.max_step = std::stod(next());
-      else if (a == "--corrector") o.joint = joint_corrector(next(), a);
+    example_cli::arguments args(argc, argv);
+    for (std::string a; args.next(a);) {
+      if (a == "--grid") o.grid = level_named(args.value());
+      else if (a == "--case") o.scase = case_named(args.value());
+      else if (a == "--mach-min") o.mach_min = args.number();
+      else if (a == "--mach-max") o.mach_max = args.number();
+      else if (a == "--out") o.out = args.value();
+      else if (a == "--fill") o.fill = args.integer();
+      else if (a == "--max-points") o.max_points = args.integer();
+      else if (a == "--nu-scale") o.nu_scale = args.number();
+      else if (a == "--mu-scale") o.mu_scale = args.number();
+      else if (a == "--omega-scale") o.omega_scale = args.number();
+      else if (a == "--max-step") o.max_step = args.number();
+      else if (a == "--corrector") o.joint = joint_corrector(args.value(), a);
       else throw input_error("unknown option " + a);
     }
     require(o.mach_min < o.mach_max, "--mach-min must be below --mach-max");

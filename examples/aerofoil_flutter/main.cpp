@@ -51,6 +51,7 @@
 #include <string>
 #include <vector>
 
+#include "../common/cli.hpp"
 #include "parts.hpp"
 #include "setup.hpp"
 
@@ -183,20 +184,10 @@ std::vector<grid_level> grid_list(const std::string& v) {
 
 options parse(int argc, char** argv) {
   options o;
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    auto next = [&]() -> std::string {
-      require(i + 1 < argc, "option ", a, " needs a value");
-      return argv[++i];
-    };
-    auto number = [&]() -> double {
-      const std::string v = next();
-      try {
-        return std::stod(v);
-      } catch (const std::exception&) {
-        throw input_error(a + " takes a number, not '" + v + "'");
-      }
-    };
+  example_cli::arguments args(argc, argv);
+  for (std::string a; args.next(a);) {
+    auto next = [&] { return args.value(); };
+    auto number = [&] { return args.number(); };
     if (a == "--case") {
       const std::string v = next();
       o.cases = v == "both" ? std::vector<structural_case>{light_case, heavy_case} : std::vector{case_named(v)};

@@ -30,12 +30,13 @@
 #include <aerohopf/flow/vortex_lattice.hpp>
 #include <aerohopf/flow/wing_geometry.hpp>
 #include <aerohopf/flow/wing_grid.hpp>
-#include <aerohopf/io/plot3d.hpp>
 #include <aerohopf/io/csv.hpp>
 #include <aerohopf/io/nastran.hpp>
+#include <aerohopf/io/plot3d.hpp>
 #include <aerohopf/io/vtk.hpp>
 #include <aerohopf/structure/modal_data.hpp>
 #include <aerohopf/structure/plate_fe.hpp>
+#include <aerohopf/structure/wing_plate.hpp>
 
 #include <algorithm>
 #include <chrono>
@@ -44,6 +45,8 @@
 #include <filesystem>
 #include <iostream>
 #include <string>
+
+#include "../common/cli.hpp"
 
 using namespace aerohopf;
 
@@ -67,14 +70,10 @@ int stride_of(const std::string& level) {
 
 options parse(int argc, char** argv) {
   options o;
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    auto next = [&]() -> std::string {
-      require(i + 1 < argc, "option ", a, " needs a value");
-      return argv[++i];
-    };
+  example_cli::arguments args(argc, argv);
+  for (std::string a; args.next(a);) {
     if (a == "--mesh") {
-      const std::string v = next();
+      const std::string v = args.value();
       const auto comma = v.find(',');
       require(comma != std::string::npos, "--mesh takes NI,NJ (chordwise,spanwise quads), not ", v);
       try {
@@ -86,15 +85,10 @@ options parse(int argc, char** argv) {
       require(o.ni >= 2 && o.nj >= 2 && o.ni <= 400 && o.nj <= 400, "--mesh: NI and NJ in [2, 400] (got ", o.ni, ",",
               o.nj, ")");
     } else if (a == "--modes") {
-      const std::string v = next();
-      try {
-        o.modes = std::stoi(v);
-      } catch (const std::exception&) {
-        throw input_error("--modes takes an integer, not '" + v + "'");
-      }
+      o.modes = args.integer();
       require(o.modes >= 1 && o.modes <= 20, "--modes must lie in [1, 20] (got ", o.modes, ")");
     } else if (a == "--steady") {
-      o.steady = next();
+      o.steady = args.value();
       if (o.steady != "none") stride_of(o.steady);
     } else if (a == "--fine-grid") {
       o.fine_grid = true;
@@ -107,30 +101,6 @@ options parse(int argc, char** argv) {
   return o;
 }
 
-/// Laminated mahogany of the weakened model 3 (spec 06), fibre along the quarter-chord line.
-structure::orthotropic_material mahogany(const flow::wing_planform& p) {
-  structure::orthotropic_material m;
-  m.e1 = 3.1511e9;
-  m.e2 = 0.4162e9;
-  m.g12 = 0.4392e9;
-  m.nu12 = 0.31;
-  m.density = 381.98;
-  m.fibre_angle = std::atan(p.sweep_tan(0.25));
-  return m;
-}
-
-/// Structured mesh over the planform (uniform in chord fraction and span), thickness of the
-/// section; the root nodes (j = 0) are clamped.
-structure::plate_mesh wing_mesh(const flow::wing_geometry& w, int ni, int nj) {
-  return structure::structured_plate_mesh(
-      ni, nj,
-      [&](double s, double r) {
-        const double y = r * w.planform.semi_span;
-        return Eigen::Vector2d(w.planform.x_at(s, y), y);
-      },
-      [&](double x, double y) { return w.thickness(x, y); });
-}
-
 struct solved {
   structure::plate_mesh mesh;
   structure::plate_modes modes;
@@ -140,14 +110,12 @@ struct solved {
 solved modes_on(const flow::wing_geometry& w, int ni, int nj, int count) {
   const auto t0 = std::chrono::steady_clock::now();
   solved s;
-  s.mesh = wing_mesh(w, ni, nj);
-  structure::plate_constraints c(s.mesh.nodes.size());
-  for (int i = 0; i <= ni; ++i) c.clamp(i);
-  const structure::plate_matrices km = structure::assemble_plate(s.mesh, mahogany(w.planform));
+  s.mesh = structure::wing_plate_mesh(w, ni, nj);
+  const structure::plate_matrices km = structure::assemble_plate(s.mesh, structure::agard445_6_mahogany(w.planform));
   s.mass = structure::plate_mass(km);
   structure::plate_mode_options mo;
   mo.count = count;
-  s.modes = structure::plate_modes_of(km, c, mo);
+  s.modes = structure::plate_modes_of(km, structure::clamped_root(s.mesh, ni), mo);
   s.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return s;
 }

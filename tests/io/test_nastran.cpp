@@ -113,23 +113,31 @@ TEST(Nastran, PlateModesRoundTrip) {
 TEST(Nastran, MalformedFilesAreRefusedWithTheirLine) {
   const std::string bulk = write_file("grid_ok.bdf", grid_small);
   expect_refused(write_file("p_none.pch", "$TITLE = nothing\n"), bulk, "no $EIGENVALUE lines");
-  std::string p = punch_two_modes;
-  p.replace(p.find("-CONT-                  0.000000E+00     -2.0"), 6, "     9");
-  expect_refused(write_file("p_cont.pch", p), bulk, "line 7:");
-  p = punch_two_modes;
-  p.replace(p.find("         3       G      0.000000E+00      0.000000E+00     -2.5"), 10, "        77");
-  expect_refused(write_file("p_unknown.pch", p), bulk, "point 77 has no GRID entry");
-  p = punch_two_modes;
-  p.replace(p.find("3.9478418E+03"), 13, "-3.9478418E+3");
-  expect_refused(write_file("p_neg.pch", p), bulk, "negative eigenvalue");
-  p = punch_two_modes;
-  p.replace(p.find("5.000000E-01"), 12, "5.00000xE-01");
-  expect_refused(write_file("p_num.pch", p), bulk, "line 6: translations T1 T2 T3 value '5.00000xE-01'");
-  p = punch_two_modes;
-  p.replace(p.find("         2       G      0.000000E+00      0.000000E+00      1.0"), 18, "         2       S");
-  expect_refused(write_file("p_type.pch", p), bulk, "type 'S'");
+  // one edit of the good punch file each: what is replaced, by what, and the message expected
+  struct edit {
+    const char* find;
+    std::size_t length;
+    const char* replacement;
+    const char* message;
+  };
+  const edit edits[] = {
+      {"-CONT-                  0.000000E+00     -2.0", 6, "     9", "line 7:"},
+      {"         3       G      0.000000E+00      0.000000E+00     -2.5", 10, "        77", "point 77 has no GRID entry"},
+      {"3.9478418E+03", 13, "-3.9478418E+3", "negative eigenvalue"},
+      {"5.000000E-01", 12, "5.00000xE-01", "line 6: translations T1 T2 T3 value '5.00000xE-01'"},
+      {"         2       G      0.000000E+00      0.000000E+00      1.0", 18, "         2       S", "type 'S'"},
+  };
+  int n = 0;
+  for (const edit& e : edits) {
+    std::string p = punch_two_modes;
+    const auto at = p.find(e.find);
+    ASSERT_NE(at, std::string::npos) << e.find;
+    p.replace(at, e.length, e.replacement);
+    expect_refused(write_file("p_edit" + std::to_string(n++) + ".pch", p), bulk, e.message);
+  }
   // a mode that misses a point
-  p = punch_two_modes.substr(0, punch_two_modes.find("         1       G      0.000000E+00      0.000000E+00      2.0"));
+  const std::string p =
+      punch_two_modes.substr(0, punch_two_modes.find("         1       G      0.000000E+00      0.000000E+00      2.0"));
   expect_refused(write_file("p_missing.pch", p), bulk, "mode 2 has no values for GRID 1");
   expect_refused(write_file("p_ok.pch", punch_two_modes),
                  write_file("grid_cp.bdf", "GRID           1       5      0.      0.      0.\n"),
