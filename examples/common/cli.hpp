@@ -24,32 +24,24 @@ class arguments {
     aerohopf::require(i_ + 1 < argc_, "option ", option_, " needs a value");
     return argv_[++i_];
   }
-  double number() {
-    const std::string v = value();
-    std::size_t used = 0;
-    double x = 0;
-    try {
-      x = std::stod(v, &used);
-    } catch (const std::exception&) {
-      used = 0;
-    }
-    if (used == 0 || used != v.size()) throw aerohopf::input_error(option_ + " takes a number, not '" + v + "'");
-    return x;
-  }
-  int integer() {
-    const std::string v = value();
-    std::size_t used = 0;
-    int x = 0;
-    try {
-      x = std::stoi(v, &used);
-    } catch (const std::exception&) {
-      used = 0;
-    }
-    if (used == 0 || used != v.size()) throw aerohopf::input_error(option_ + " takes an integer, not '" + v + "'");
-    return x;
-  }
+  double number() { return parsed<double>("a number", [](const std::string& v, std::size_t* u) { return std::stod(v, u); }); }
+  int integer() { return parsed<int>("an integer", [](const std::string& v, std::size_t* u) { return std::stoi(v, u); }); }
 
  private:
+  /// The value converted by convert (std::stod-like), all of it used, else input_error.
+  template <class T, class Convert>
+  T parsed(const char* what, Convert convert) {
+    const std::string v = value();
+    std::size_t used = 0;
+    T x{};
+    try {
+      x = convert(v, &used);
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    if (used == 0 || used != v.size()) throw aerohopf::input_error(option_ + " takes " + what + ", not '" + v + "'");
+    return x;
+  }
   int argc_;
   char** argv_;
   int i_ = 0;
