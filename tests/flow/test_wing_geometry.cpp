@@ -72,3 +72,33 @@ TEST(WingGeometry, RefusesMalformedSections) {
   p.tip_chord = -1;
   EXPECT_THROW(p.validate("test"), input_error);
 }
+
+TEST(WingGeometry, CamberedAndParabolicArcSections) {
+  // a cambered section: thickness 2 z_t and camber m(x) = 0.04 x (1 - x)
+  std::vector<double> x = {0, 0.05, 0.1, 0.2, 0.3, 0.5, 0.7, 0.9, 1};
+  std::vector<double> up(x.size()), lo(x.size());
+  for (std::size_t i = 0; i < x.size(); ++i) {
+    const double t = 0.06 * std::sqrt(x[i]) * (1 - x[i]), m = 0.04 * x[i] * (1 - x[i]);
+    up[i] = m + t;
+    lo[i] = m - t;
+  }
+  const section_ordinates s(x, up, lo, "cambered");
+  EXPECT_FALSE(s.symmetric());
+  for (std::size_t i = 0; i < x.size(); ++i) {
+    EXPECT_NEAR(s.upper(x[i]), up[i], 1e-15);
+    EXPECT_NEAR(s.lower(x[i]), lo[i], 1e-15);
+    EXPECT_NEAR(s.camber(x[i]), 0.04 * x[i] * (1 - x[i]), 1e-15);
+  }
+  EXPECT_GT(s.thickness_ratio(), 0.04);
+  EXPECT_THROW(section_ordinates({0, 0.5, 1}, {0, 0.01, 0}, {0, 0.02, 0}, "crossed"), input_error);
+  EXPECT_THROW(section_ordinates({0, 0.5, 1}, {0.01, 0.02, 0}, {0, -0.02, 0}, "open nose"), input_error);
+  const section_ordinates sym = naca65a004();
+  EXPECT_TRUE(sym.symmetric());
+  EXPECT_EQ(sym.camber(0.3), 0.0);
+  EXPECT_EQ(sym.lower(0.3), -sym.upper(0.3));
+  // the Goland wing's 4 % parabolic arc
+  const section_ordinates arc = parabolic_arc(0.04);
+  EXPECT_NEAR(arc.thickness_ratio(), 0.04, 1e-6);
+  for (double xi : {0.13, 0.5, 0.77}) EXPECT_NEAR(arc.half_thickness(xi), 0.08 * xi * (1 - xi), 2e-6);
+  EXPECT_THROW(parabolic_arc(0.0), input_error);
+}

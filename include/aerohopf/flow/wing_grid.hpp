@@ -1,5 +1,6 @@
 #pragma once
-// C-H grid around a swept, tapered wing (wing_geometry.hpp) with a symmetry plane at the root
+// C-H grid around a swept, tapered wing (wing_geometry.hpp; symmetric or cambered sections, a
+// cambered one's cut beyond the tip on the tip's camber line) with a symmetry plane at the root
 // and a closed, rounded tip: one block, generated as the finest level of a family from which
 // coarsen() makes the others (strides 2, 4, 8: nested levels for grid sequencing).
 //
@@ -72,7 +73,8 @@ struct grid_quality {
 
 namespace internal {
 /// Chord fractions of n + 1 points from leading to trailing edge, uniform in the arc length of
-/// the section (thickness factor 1) with clustering a at both ends (as naca_cgrid).
+/// the section's thickness distribution (thickness factor 1) with clustering a at both ends (as
+/// naca_cgrid); the same fractions serve both surfaces of a cambered section.
 inline std::vector<double> chord_fractions(const section_ordinates& s, double thickness_scale, int n, double a) {
   const int nfine = 20001;
   std::vector<double> xi(nfine), arc(nfine, 0.0);
@@ -153,11 +155,11 @@ inline multiblock_grid<3> wing_cgrid(const wing_geometry& w, const wing_grid_opt
     // inner C-curve in (x, z), lower wake exit first (left normals point into the field)
     auto section_point = [&](int m, double side, double sig) -> internal::point2 {
       const double f = xi[static_cast<std::size_t>(m)];
-      return {xle + f * c, side * sig * w.section.half_thickness(f) * c};
+      return {xle + f * c, c * w.section.camber(f) + side * sig * w.section.half_thickness(f) * c};
     };
     const double h_te = std::hypot(c * (xi[static_cast<std::size_t>(ns)] - xi[static_cast<std::size_t>(ns - 1)]),
                                    sigma * c * w.section.half_thickness(xi[static_cast<std::size_t>(ns - 1)]));
-    const double x_te = xle + c;
+    const double x_te = xle + c, z_te = c * w.section.camber(1.0);  // the wake leaves the trailing edge along x
     const double r_wake = internal::geometric_ratio(h_te, nw, x_exit - x_te);
     std::vector<double> wake_x(static_cast<std::size_t>(nw) + 1, x_te);
     for (int m = 1; m <= nw; ++m)
@@ -166,13 +168,13 @@ inline multiblock_grid<3> wing_cgrid(const wing_geometry& w, const wing_grid_opt
     auto inner_curve = [&](double sig) {
       std::vector<internal::point2> curve(static_cast<std::size_t>(ni));
       std::size_t q = 0;
-      for (int m = nw; m >= 0; --m) curve[q++] = {wake_x[static_cast<std::size_t>(m)], 0.0};
+      for (int m = nw; m >= 0; --m) curve[q++] = {wake_x[static_cast<std::size_t>(m)], z_te};
       --q;  // the trailing edge is shared
       for (int m = ns; m >= 0; --m) curve[q++] = section_point(m, -1.0, sig);
       --q;  // the leading edge is shared
       for (int m = 0; m <= ns; ++m) curve[q++] = section_point(m, +1.0, sig);
       --q;
-      for (int m = 0; m <= nw; ++m) curve[q++] = {wake_x[static_cast<std::size_t>(m)], 0.0};
+      for (int m = 0; m <= nw; ++m) curve[q++] = {wake_x[static_cast<std::size_t>(m)], z_te};
       return curve;
     };
     const auto curve = inner_curve(sigma);
