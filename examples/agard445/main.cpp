@@ -208,9 +208,9 @@ int main(int argc, char** argv) try {
     const int s = stride_of(level);
     const flow::multiblock_grid<3> g = s == 1 ? fine : flow::coarsen(fine, s);
     const flow::grid_quality q = flow::hexahedron_quality(g);
-    const int ks = go.span_cells / s, i0 = go.wake_cells / s, i1 = i0 + 2 * go.section_cells / s;
-    const flow::grid_quality t = flow::hexahedron_quality(g, 0, {i0, 0, ks - 2}, {i1, 2, ks + 2});
-    const auto wing_points = static_cast<long long>((i1 - i0 + 1) * (ks + 1));
+    const auto [tip_lo, tip_hi] = flow::wing_grid_layout::of(go, s).tip_cells();
+    const flow::grid_quality t = flow::hexahedron_quality(g, 0, tip_lo, tip_hi);
+    const auto wing_points = static_cast<long long>(flow::wing_grid_layout::of(go, s).wing_points());
     const auto points = static_cast<long long>(g.points.blocks[0].n_points());
     std::printf("  %-12s %9lld %9zu %7lld %10.2e %9.3f %9zu %9.3f\n", level.c_str(), points, q.cells, wing_points,
                 q.min_volume, q.min_corner_ratio, q.collinear_cells, t.min_corner_ratio);

@@ -68,11 +68,11 @@ TEST(MeshDeformation, JLineWeightsRunFromOneToZero) {
 TEST(MeshDeformation, LinearMotionIsExactOnTheWingAndTheOuterBoundaryStays) {
   const wing_modal_motion mo(very_coarse(), linear_modes(), options());
   const auto& b = very_coarse().points.blocks[0];
-  const flow::wing_grid_options& g = options().grid;
-  const int nw = g.wake_cells / 8, ns = g.section_cells / 8, ks = g.span_cells / 8, ni = b.points[0];
+  const flow::wing_grid_layout l = flow::wing_grid_layout::of(options().grid, 8);
+  const int ks = l.tip, ni = b.points[0];
   const double cr = wing().planform.root_chord;
   for (int k = 0; k < ks; ++k)
-    for (int i = nw; i <= nw + 2 * ns; ++i) {  // on the wing: the spline reproduces the linear field
+    for (int i = l.wing_begin; i <= l.wing_end; ++i) {  // on the wing: the spline reproduces the linear field
       const auto& x = b.at({i, 0, k});
       const std::size_t p = flow::linear_index<3>({i, 0, k}, b.points);
       EXPECT_NEAR(mo.basis(0)[p][2], x[0] * cr - 0.3, 1e-10);
@@ -84,7 +84,7 @@ TEST(MeshDeformation, LinearMotionIsExactOnTheWingAndTheOuterBoundaryStays) {
       const std::size_t outer = flow::linear_index<3>({i, b.points[1] - 1, k}, b.points);
       for (int m = 0; m < 2; ++m) EXPECT_NEAR(mo.basis(m)[outer][2], 0.0, 1e-12);
       // the cuts stay closed: i and ni - 1 - i coincide on j = 0 off the wing
-      if (i <= nw || (k >= ks && i <= nw + ns)) {
+      if (i <= l.wing_begin || (k >= ks && i <= l.leading_edge)) {
         const std::size_t a = flow::linear_index<3>({i, 0, k}, b.points), c = flow::linear_index<3>({ni - 1 - i, 0, k}, b.points);
         for (int m = 0; m < 2; ++m)
           for (int d = 0; d < 3; ++d) EXPECT_NEAR(mo.basis(m)[a][d], mo.basis(m)[c][d], 1e-12);
@@ -108,9 +108,9 @@ TEST(MeshDeformation, PlateModesKeepCellsPositiveAndJetsGiveTheBasis) {
   EXPECT_GT(q.min_volume, 0.0);
   // every corner stays positive except at the cut's leading edge beyond the tip, where the rest
   // grid has its collinear (180 deg) corners: those cells may turn slightly non-convex there
-  const flow::wing_grid_options& g = options().grid;
   const auto cells = moved.topology.cells[0];
-  const int le = (g.wake_cells + g.section_cells) / 8, ks = g.span_cells / 8;
+  const flow::wing_grid_layout l = flow::wing_grid_layout::of(options().grid, 8);
+  const int le = l.leading_edge, ks = l.tip;
   const flow::grid_quality inboard = flow::hexahedron_quality(moved, 0, {0, 0, 0}, {cells[0], cells[1], ks - 1});
   const flow::grid_quality off_edge = flow::hexahedron_quality(moved, 0, {0, 1, 0}, cells);
   const flow::grid_quality lower = flow::hexahedron_quality(moved, 0, {0, 0, ks - 1}, {le - 1, 1, cells[2]});

@@ -30,9 +30,7 @@ constexpr wing_grid_options defaults{};
 TEST(WingGrid, LevelSizesMatchTheIssue) {
   const auto medium = coarsen(fine(), 2), coarse = coarsen(fine(), 4), very = coarsen(fine(), 8);
   EXPECT_EQ(fine().points.blocks[0].n_points(), 289u * 65 * 81);
-  const auto wing_points = [](int s) {
-    return static_cast<std::size_t>(2 * defaults.section_cells / s + 1) * static_cast<std::size_t>(defaults.span_cells / s + 1);
-  };
+  const auto wing_points = [](int s) { return wing_grid_layout::of(defaults, s).wing_points(); };
   EXPECT_NEAR(static_cast<double>(coarse.points.blocks[0].n_points()), 27000, 2000);
   EXPECT_NEAR(static_cast<double>(wing_points(4)), 1100, 250);
   EXPECT_NEAR(static_cast<double>(medium.points.blocks[0].n_points()), 190000, 15000);
@@ -50,8 +48,8 @@ TEST(WingGrid, CellsArePositiveAndTheTipCellsGood) {
     // the collinear corners: the leading-edge cells of the cut, from the tip station outward
     EXPECT_EQ(q.collinear_cells, static_cast<std::size_t>(2 * (defaults.outboard_cells / s + 1))) << "stride " << s;
     // the wall cells round the tip cap (two stations either side of the tip, two layers)
-    const int ks = defaults.span_cells / s, i0 = defaults.wake_cells / s, i1 = i0 + 2 * defaults.section_cells / s;
-    const grid_quality t = hexahedron_quality(g, 0, {i0, 0, ks - 2}, {i1, 2, ks + 2});
+    const auto [lo, hi] = wing_grid_layout::of(defaults, s).tip_cells();
+    const grid_quality t = hexahedron_quality(g, 0, lo, hi);
     EXPECT_GT(t.min_corner_ratio, 0.15) << "stride " << s;
     EXPECT_GT(t.min_volume, 0.0);
   }
@@ -61,14 +59,15 @@ TEST(WingGrid, CutsCoincideAndTheWallIsTheWing) {
   const auto g = coarsen(fine(), 4);
   const auto& b = g.points.blocks[0];
   const int ni = b.points[0] - 1, nk = b.points[2] - 1;
-  const int nw = defaults.wake_cells / 4, ns = defaults.section_cells / 4, ks = defaults.span_cells / 4;
+  const wing_grid_layout l = wing_grid_layout::of(defaults, 4);
+  const int nw = l.wing_begin, ks = l.tip;
   for (int k = 0; k <= nk; ++k) {
     for (int i = 0; i <= nw; ++i) {  // wake cut: upper side i <-> lower side ni - i
       const auto &u = b.at({i, 0, k}), &l = b.at({ni - i, 0, k});
       for (int d = 0; d < 3; ++d) EXPECT_NEAR(u[d], l[d], 1e-12) << "wake, i " << i << " k " << k;
     }
     if (k >= ks)
-      for (int i = nw; i <= nw + ns; ++i) {  // beyond the tip: upper surface <-> lower surface
+      for (int i = nw; i <= l.leading_edge; ++i) {  // beyond the tip: upper surface <-> lower surface
         const auto &u = b.at({i, 0, k}), &l = b.at({ni - i, 0, k});
         for (int d = 0; d < 3; ++d) EXPECT_NEAR(u[d], l[d], 1e-12) << "tip cut, i " << i << " k " << k;
       }
@@ -77,12 +76,12 @@ TEST(WingGrid, CutsCoincideAndTheWallIsTheWing) {
   const double cr = w.planform.root_chord;
   for (int i = 0; i <= ni; ++i) EXPECT_EQ(b.at({i, 0, 0})[1], 0.0);  // root on the symmetry plane
   for (int k = 0; k < ks - 1; k += 2)  // wall points on the section (root chords)
-    for (int i = nw; i <= nw + 2 * ns; i += 3) {
+    for (int i = l.wing_begin; i <= l.wing_end; i += 3) {
       const auto& x = b.at({i, 0, k});
       const double y = x[1] * cr, c = w.planform.chord(y), xi = (x[0] * cr - w.planform.x_leading_edge(y)) / c;
       EXPECT_NEAR(std::abs(x[2]) * cr, w.section.half_thickness(xi) * c, 1e-9) << "i " << i << " k " << k;
     }
-  EXPECT_NEAR(b.at({nw + ns, 0, ks})[1] * cr, w.planform.semi_span, 1e-12);  // the tip station
+  EXPECT_NEAR(b.at({l.leading_edge, 0, ks})[1] * cr, w.planform.semi_span, 1e-12);  // the tip station
 }
 
 TEST(WingGrid, FreeStreamIsPreservedWithTheWingOpened) {
@@ -129,7 +128,8 @@ TEST(WingGrid, CamberedWingLiftsAtZeroIncidence) {
   // off the cut's leading edge beyond the tip the cells are as good as the symmetric wing's; on
   // it, the 180 deg corner of a symmetric cut bends with the camber line (slightly non-convex)
   const auto cells = g.topology.cells[0];
-  const int le = (defaults.wake_cells + defaults.section_cells) / 8, ks = defaults.span_cells / 8;
+  const wing_grid_layout l = wing_grid_layout::of(defaults, 8);
+  const int le = l.leading_edge, ks = l.tip;
   for (const grid_quality& r : {hexahedron_quality(g, 0, {0, 0, 0}, {cells[0], cells[1], ks - 1}),
                                 hexahedron_quality(g, 0, {0, 1, 0}, cells),
                                 hexahedron_quality(g, 0, {0, 0, ks - 1}, {le - 1, 1, cells[2]}),
@@ -139,9 +139,9 @@ TEST(WingGrid, CamberedWingLiftsAtZeroIncidence) {
   EXPECT_GT(edge.min_volume, 0.0);
   EXPECT_GT(edge.min_ratio_all, -0.05);
   const auto& b = g.points.blocks[0];
-  const int ni = b.points[0] - 1, nw = defaults.wake_cells / 8, ns = defaults.section_cells / 8;
-  for (int k = defaults.span_cells / 8; k < b.points[2]; ++k)
-    for (int i = 0; i <= nw + ns; ++i)
+  const int ni = b.points[0] - 1;
+  for (int k = l.tip; k < b.points[2]; ++k)
+    for (int i = 0; i <= l.leading_edge; ++i)
       for (int d = 0; d < 3; ++d) EXPECT_NEAR(b.at({i, 0, k})[d], b.at({ni - i, 0, k})[d], 1e-12);
   euler_model<3> m(g, {.mach = 0.5, .alpha_rad = 0.0}, {.force_tag = "wing"});
   vec<double> s = m.free_stream_vector();

@@ -77,13 +77,12 @@ class wing_modal_motion {
     require(o.length_scale > 0 && o.stride >= 1, who, ": length_scale must be > 0 and stride >= 1 (got ",
             o.length_scale, ", ", o.stride, ")");
     const auto n = rest_.points;
-    const int s = o.stride;
-    const int nw = o.grid.wake_cells / s, ns = o.grid.section_cells / s, ks = o.grid.span_cells / s;
-    require(n[0] == 2 * nw + 2 * ns + 1 && n[2] == ks + o.grid.outboard_cells / s + 1, who,
+    const flow::wing_grid_layout l = flow::wing_grid_layout::of(o.grid, o.stride);
+    require(n[0] == l.cells[0] + 1 && n[1] == l.cells[1] + 1 && n[2] == l.cells[2] + 1, who,
             ": the grid is not the wing_cgrid level of these options and stride (", n[0], " x ", n[1], " x ", n[2],
             " points)");
     // the wing's points on j = 0 (section indices, root to tip station) and the spline to them
-    const int i_lo = nw, i_hi = nw + 2 * ns, ni_wing = i_hi - i_lo + 1;
+    const int i_lo = l.wing_begin, i_hi = l.wing_end, ks = l.tip, ni_wing = i_hi - i_lo + 1;
     std::vector<Eigen::Vector3d> face;
     for (int k = 0; k <= ks; ++k)
       for (int i = i_lo; i <= i_hi; ++i) {

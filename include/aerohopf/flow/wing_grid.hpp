@@ -32,6 +32,7 @@
 #include <limits>
 #include <numbers>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "../error.hpp"
@@ -54,6 +55,36 @@ struct wing_grid_options {
   double smoothing = 8.0;
   int redistribution_passes = 20;
   int multiple = 8;          ///< every cell count must divide by this (coarsest stride)
+};
+
+/// Where the wing and the cuts lie in the cell indices of a wing_cgrid level (stride 1: the fine
+/// grid wing_cgrid makes, s: coarsen(fine, s)). Point index i = wing_begin is the upper trailing
+/// edge, leading_edge the leading edge, wing_end the lower trailing edge; point k = tip the tip
+/// station. Cells [wing_begin, wing_end) x [0, tip) of the face j = 0 are the wing.
+struct wing_grid_layout {
+  int wing_begin = 0, leading_edge = 0, wing_end = 0, tip = 0;
+  index_d<3> cells{};
+
+  static wing_grid_layout of(const wing_grid_options& o, int stride = 1) {
+    require(stride >= 1 && o.wake_cells % stride == 0 && o.section_cells % stride == 0 && o.normal_cells % stride == 0 &&
+                o.span_cells % stride == 0 && o.outboard_cells % stride == 0,
+            "wing_grid_layout: stride ", stride, " does not divide the grid's cell counts");
+    wing_grid_layout l;
+    l.wing_begin = o.wake_cells / stride;
+    l.leading_edge = l.wing_begin + o.section_cells / stride;
+    l.wing_end = l.leading_edge + o.section_cells / stride;
+    l.tip = o.span_cells / stride;
+    l.cells = {l.wing_end + o.wake_cells / stride, o.normal_cells / stride, l.tip + o.outboard_cells / stride};
+    return l;
+  }
+  /// Points on the wing surface (both sides, root to tip station).
+  std::size_t wing_points() const {
+    return static_cast<std::size_t>(wing_end - wing_begin + 1) * static_cast<std::size_t>(tip + 1);
+  }
+  /// The wall cells round the tip: `stations` either side of the tip station, `layers` off the wall.
+  std::pair<index_d<3>, index_d<3>> tip_cells(int stations = 2, int layers = 2) const {
+    return {{wing_begin, 0, tip - stations}, {wing_end, layers, tip + stations}};
+  }
 };
 
 /// Cell-quality figures of hexahedral cells (hexahedron_quality).
@@ -198,7 +229,8 @@ inline multiblock_grid<3> wing_cgrid(const wing_geometry& w, const wing_grid_opt
   auto sym = whole_face<3>(0, 4, cells, bk::wall);
   sym.tag = "symmetry";
   pt.push_back(sym);
-  const int i_lo = nw, i_le = nw + ns, i_hi = nw + 2 * ns, ks = o.span_cells, kn = cells[2];
+  const wing_grid_layout l = wing_grid_layout::of(o);
+  const int i_lo = l.wing_begin, i_le = l.leading_edge, i_hi = l.wing_end, ks = l.tip, kn = cells[2];
   auto wing = whole_face<3>(0, 2, cells, bk::wall);
   wing.begin = {i_lo, 0, 0};
   wing.end = {i_hi, 0, ks};
