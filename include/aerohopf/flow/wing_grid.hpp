@@ -104,16 +104,16 @@ struct grid_quality {
 
 namespace internal {
 /// Chord fractions of n + 1 points from leading to trailing edge, uniform in the arc length of
-/// the section's thickness distribution (thickness factor 1) with clustering a at both ends (as
-/// naca_cgrid); the same fractions serve both surfaces of a cambered section.
-inline std::vector<double> chord_fractions(const section_ordinates& s, double thickness_scale, int n, double a) {
+/// the section's thickness distribution with clustering a at both ends (as naca_cgrid); the same
+/// fractions serve both surfaces of a cambered section.
+inline std::vector<double> chord_fractions(const section_ordinates& s, int n, double a) {
   const int nfine = 20001;
   std::vector<double> xi(nfine), arc(nfine, 0.0);
   for (int k = 0; k < nfine; ++k) {
     xi[static_cast<std::size_t>(k)] = 0.5 * (1.0 - std::cos(std::numbers::pi * k / (nfine - 1)));
     if (k) {
       const auto u = static_cast<std::size_t>(k);
-      const double dz = thickness_scale * (s.half_thickness(xi[u]) - s.half_thickness(xi[u - 1]));
+      const double dz = s.half_thickness(xi[u]) - s.half_thickness(xi[u - 1]);
       arc[u] = arc[u - 1] + std::hypot(xi[u] - xi[u - 1], dz);
     }
   }
@@ -174,7 +174,7 @@ inline multiblock_grid<3> wing_cgrid(const wing_geometry& w, const wing_grid_opt
     return std::sqrt(std::max(0.0, 1 - u * u));
   };
 
-  const std::vector<double> xi = internal::chord_fractions(w.section, 1.0, ns, o.clustering);
+  const std::vector<double> xi = internal::chord_fractions(w.section, ns, o.clustering);
   const double x_exit = p.x_at(1.0, 0.0) + o.far_field * cr;  // one outflow plane for every station
   multiblock_grid<3> g;
   grid_block<double, 3> blk;

@@ -29,6 +29,7 @@
 
 #include "../error.hpp"
 #include "../structure/modal_data.hpp"
+#include "text_numbers.hpp"
 
 namespace aerohopf::io {
 
@@ -40,40 +41,16 @@ inline std::string trim(const std::string& s) {
 }
 
 /// A NASTRAN real field: 1.5, 1.5E-3, 1.5D-3, 1.5-3 (implicit exponent), 7. (nullopt if not a
-/// real number).
+/// finite real number).
 inline std::optional<double> nastran_real(const std::string& field) {
-  std::string s = trim(field);
-  if (s.empty()) return std::nullopt;
-  for (char& c : s)
-    if (c == 'D' || c == 'd') c = 'E';
-  // implicit exponent: a sign after the mantissa's first character, not after E
-  for (std::size_t i = 1; i < s.size(); ++i)
-    if ((s[i] == '+' || s[i] == '-') && s[i - 1] != 'E' && s[i - 1] != 'e') {
-      s = s.substr(0, i) + 'E' + s.substr(i);  // (not insert: GCC 12 warns -Wrestrict on it)
-      break;
-    }
-  std::size_t used = 0;
   double v = 0;
-  try {
-    v = std::stod(s, &used);
-  } catch (const std::exception&) {
-    return std::nullopt;
-  }
-  if (used != s.size() || !std::isfinite(v)) return std::nullopt;
+  if (parse_real(trim(field), v) != real_status::ok || !std::isfinite(v)) return std::nullopt;
   return v;
 }
 
 inline std::optional<long long> nastran_int(const std::string& field) {
-  const std::string s = trim(field);
-  if (s.empty()) return std::nullopt;
-  std::size_t used = 0;
   long long v = 0;
-  try {
-    v = std::stoll(s, &used);
-  } catch (const std::exception&) {
-    return std::nullopt;
-  }
-  if (used != s.size()) return std::nullopt;
+  if (!parse_integer(trim(field), v)) return std::nullopt;
   return v;
 }
 

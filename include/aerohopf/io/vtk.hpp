@@ -1,9 +1,10 @@
 #pragma once
 // Legacy-VTK output for ParaView: a multi-block flow field (all blocks in one UNSTRUCTURED_GRID
 // file, quads in 2D, hexahedra in 3D, with cell data density, velocity, pressure, Mach number
-// and Cp), the wall surface of a 3D flow (quads with the wall pressure and Cp), and a plate mesh with its structural modes (point data: thickness, each mode's
-// deflection as a scalar and as a displacement vector for ParaView's Warp By Vector). Legacy
-// ASCII is chosen because it needs no XML/base64 machinery and every ParaView version reads it.
+// and Cp), the wall surface of a 3D flow (quads with the wall pressure and Cp), and a plate mesh
+// with its structural modes (point data: thickness, each mode's deflection as a scalar and as a
+// displacement vector for ParaView's Warp By Vector). Legacy ASCII is chosen because it needs no
+// XML/base64 machinery and every ParaView version reads it.
 #include <fstream>
 #include <iomanip>
 #include <map>
