@@ -15,7 +15,8 @@
 // an approximate one (a modified-order CFD Jacobian) differs at O(1) componentwise. Random
 // directions hit every entry: an entry can only escape if a v_j is zero.
 // Checked, when the system has them: jacobian (always), approximate_jacobian,
-// block_jacobians (the (exact, approximate) block pair, models::aerofoil_system), d_mu (against
+// block_jacobians (the (exact, approximate) block pair, models::aerofoil_system), the bordered
+// pair of the Krylov path (bordered_jacobians: models::aerofoil_system, models::wing_system), d_mu (against
 // a taylor<double, 1> pass in mu). Absent members are reported with present = false.
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
@@ -41,7 +42,7 @@ struct jacobian_check_options {
   int probes = 3;              ///< random directions v (>= 1)
   std::uint64_t seed = 1;      ///< of the directions (splitmix64: the same on every platform)
   bool approximate = true;     ///< check approximate_jacobian if the system has one
-  bool blocks = true;          ///< check block_jacobians if the system has them
+  bool blocks = true;          ///< check block_jacobians / bordered_jacobians if the system has them
   bool d_mu = true;            ///< check d_mu if the system has it
 };
 
@@ -59,11 +60,14 @@ struct jacobian_check_entry {
 struct jacobian_check_report {
   int probes = 0;
   jacobian_check_entry exact{"jacobian"}, approximate{"approximate_jacobian"},
-      block_exact{"block_jacobians (exact)"}, block_approximate{"block_jacobians (approximate)"}, d_mu{"d_mu"};
+      block_exact{"block_jacobians (exact)"}, block_approximate{"block_jacobians (approximate)"},
+      bordered_exact{"bordered_jacobians (exact)"}, bordered_approximate{"bordered_jacobians (preconditioning)"},
+      d_mu{"d_mu"};
 
   friend std::ostream& operator<<(std::ostream& os, const jacobian_check_report& r) {
     os << "check_jacobian (" << r.probes << " random directions):\n";
-    for (const auto* e : {&r.exact, &r.approximate, &r.block_exact, &r.block_approximate, &r.d_mu}) {
+    for (const auto* e : {&r.exact, &r.approximate, &r.block_exact, &r.block_approximate, &r.bordered_exact,
+                          &r.bordered_approximate, &r.d_mu}) {
       os << "  " << e->name << ": ";
       if (!e->present) {
         os << "not provided or not checked\n";
@@ -81,6 +85,14 @@ template <class S>
 concept has_block_jacobian_pair = system<S> && requires(const S& s, const vec<double>& w, double mu) {
   { s.block_jacobians(w, mu).first.to_sparse() } -> std::convertible_to<Eigen::SparseMatrix<double>>;
   { s.block_jacobians(w, mu).second.to_sparse() } -> std::convertible_to<Eigen::SparseMatrix<double>>;
+};
+
+/// A system with the bordered pair of the Krylov path (nonlinear/block_system.hpp's
+/// bordered_system, stated here without its header).
+template <class S>
+concept has_bordered_jacobian_pair = system<S> && requires(const S& s, const vec<double>& w, double mu) {
+  { s.bordered_jacobians(w, mu).exact.to_sparse() } -> std::convertible_to<Eigen::SparseMatrix<double>>;
+  { s.bordered_jacobians(w, mu).preconditioning.to_sparse() } -> std::convertible_to<Eigen::SparseMatrix<double>>;
 };
 
 namespace internal {
@@ -202,6 +214,14 @@ jacobian_check_report check_jacobian(const S& sys, const vec<double>& w, double 
       const auto pair = sys.block_jacobians(w, mu);
       internal::check_matrix(r.block_exact, Eigen::SparseMatrix<double>(pair.first.to_sparse()), dirs, ref);
       internal::check_matrix(r.block_approximate, Eigen::SparseMatrix<double>(pair.second.to_sparse()), dirs, ref);
+    }
+  }
+  if constexpr (has_bordered_jacobian_pair<S>) {
+    if (opt.blocks) {
+      const auto pair = sys.bordered_jacobians(w, mu);
+      internal::check_matrix(r.bordered_exact, Eigen::SparseMatrix<double>(pair.exact.to_sparse()), dirs, ref);
+      internal::check_matrix(r.bordered_approximate, Eigen::SparseMatrix<double>(pair.preconditioning.to_sparse()), dirs,
+                             ref);
     }
   }
   if constexpr (has_d_mu<S> && system_over<S, taylor<double, 1>>) {
