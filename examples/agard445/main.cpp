@@ -1,17 +1,26 @@
-// AGARD 445.6 weakened model 3 (spec 06), the parts of the wing built so far:
+// AGARD 445.6 weakened model 3 (spec 06):
 //  1. the structural modes from our own plate finite elements (structure/plate_fe.hpp): the
 //     planform and NACA 65A004 thickness of flow/wing_geometry.hpp, the orthotropic laminated
 //     mahogany with its fibre along the 45 deg quarter-chord line, clamped root; a mesh-convergence
 //     table of the first five frequencies against Yates' and the original work's;
 //  2. the C-H flow grids (flow/wing_grid.hpp): every level's size and cell quality, Plot3D files;
 //  3. the steady flow at M = 0.5, alpha = 0 and 1 deg on one level: CL, the lift slope against
-//     lifting-surface theory (vortex lattice, DATCOM), the wall Cp for ParaView.
+//     lifting-surface theory (vortex lattice, DATCOM), the wall Cp for ParaView;
+//  4. the flutter boundary of the flexible wing (four modes, flutter.hpp): flutter speed index
+//     and frequency ratio against Mach number per grid level and structural damping, by the
+//     library's flutter-boundary driver, against the experiment; the V-g / V-f diagram.
 //
 // Usage: agard445 [out_dir] [--mesh NI,NJ] [--modes K] [--steady LEVEL] [--fine-grid]
+//                 [--flutter LEVELS] [--damping PERCENTS] [--machs LIST] [--vg LEVEL] [--vg-mach M]
 //   --mesh NI,NJ   chordwise x spanwise quads of the modal mesh (default 24,24)
-//   --modes K      modes written (default 5)
+//   --modes K      modes written (default 5; the flutter part uses the first four)
 //   --steady L     level of the steady solutions: very_coarse, coarse (default), medium, none
 //   --fine-grid    also write the fine level's Plot3D file (1.5 M points, 37 MB)
+//   --flutter L    boundary levels, coarse to fine, e.g. coarse,medium (default coarse; none)
+//   --damping P    structural damping ratios in percent (default 0,0.5,2)
+//   --machs LIST   Mach numbers of the boundaries (default 0.499,0.678,0.901,0.96, the experiment's)
+//   --vg L         V-g / V-f diagram on level L (default none)   --vg-mach M (default 0.96)
+//   --verbose      a line per Newton iteration of the boundaries
 // Outputs under out_dir (default out/agard445):
 //   modes.csv          mode,frequency_hz,generalised_mass  (generalised mass of the mode scaled to a
 //                      largest deflection of 1 m, kg; the shapes are mass-normalised otherwise)
@@ -24,8 +33,16 @@
 //   steady_<level>.csv mach,alpha_deg,cl,cd,steps,gmres_iterations,seconds (CL, CD on the half-wing area)
 //   lift_slope.csv     level,mach,euler_per_rad,vortex_lattice_per_rad,datcom_per_rad
 //   surface_<level>_M0.50_alpha1.vtk   the wing's wall Cp (ParaView)
+//   boundary_<level>_zeta<percent>.csv
+//                      mach,fsi,frequency_ratio,mass_ratio,q,omega,newton_iterations,linear_iterations,
+//                      hopf_seconds,steady_seconds  (q: flutter dynamic pressure rho U^2 / 2, Pa;
+//                      omega: flutter frequency in the flow's time unit c / U)
+//   experiment.csv     mach,density,speed,mass_ratio,fsi,frequency_ratio (spec 06)
+//   vg_M<mach>_<level>.csv, vg_flutter_M<mach>_<level>.csv   the V-g diagram (parameter mu = rho c^3)
+//   costs.csv          level,damping_percent,quantity,value (Hopf work per steady solve, seconds)
 // Both exchange formats are read back and compared with the modes written (exit status 1 if not).
-// plot_modes.py in this folder turns mode_shapes.csv into modes.png.
+// plot_modes.py in this folder turns mode_shapes.csv into modes.png, plot_flutter.py the
+// boundaries and the V-g diagram into flutter_boundary.png and vg.png.
 #include <aerohopf/flow/steady_solver.hpp>
 #include <aerohopf/flow/vortex_lattice.hpp>
 #include <aerohopf/flow/wing_geometry.hpp>
@@ -47,6 +64,7 @@
 #include <string>
 
 #include "../common/cli.hpp"
+#include "flutter.hpp"
 
 using namespace aerohopf;
 
@@ -58,6 +76,7 @@ struct options {
   int modes = 5;
   std::string steady = "coarse";
   bool fine_grid = false;
+  agard445_flutter::flutter_options flutter;
 };
 
 int stride_of(const std::string& level) {
@@ -92,6 +111,28 @@ options parse(int argc, char** argv) {
       if (o.steady != "none") stride_of(o.steady);
     } else if (a == "--fine-grid") {
       o.fine_grid = true;
+    } else if (a == "--flutter") {
+      o.flutter.strides.clear();
+      for (const auto& l : args.words())
+        if (l != "none") o.flutter.strides.push_back(stride_of(l));
+      std::sort(o.flutter.strides.begin(), o.flutter.strides.end(), std::greater<>());
+    } else if (a == "--damping") {
+      o.flutter.damping_percent = args.numbers();
+      for (double z : o.flutter.damping_percent)
+        require(z >= 0 && z < 50, "--damping: percentages in [0, 50) (got ", z, ")");
+    } else if (a == "--machs") {
+      o.flutter.machs = args.numbers();
+      for (std::size_t k = 0; k < o.flutter.machs.size(); ++k)
+        require(o.flutter.machs[k] > 0.3 && o.flutter.machs[k] < 1.3 && (k == 0 || o.flutter.machs[k] > o.flutter.machs[k - 1]),
+                "--machs: increasing Mach numbers in (0.3, 1.3)");
+    } else if (a == "--vg") {
+      const std::string l = args.value();
+      o.flutter.vg_stride = l == "none" ? 0 : stride_of(l);
+    } else if (a == "--vg-mach") {
+      o.flutter.vg_mach = args.number();
+      require(o.flutter.vg_mach > 0.3 && o.flutter.vg_mach < 1.3, "--vg-mach must lie in (0.3, 1.3)");
+    } else if (a == "--verbose") {
+      o.flutter.verbose = true;
     } else if (!a.empty() && a[0] != '-') {
       o.out = a;
     } else {
@@ -247,10 +288,37 @@ int main(int argc, char** argv) try {
     csv_writer slope(o.out / "lift_slope.csv", "level,mach,euler_per_rad,vortex_lattice_per_rad,datcom_per_rad");
     slope.row({o.steady, mach, euler, vlm, datcom});
   }
+  // 4. the flutter boundaries and the V-g diagram (four modes)
+  if (!o.flutter.strides.empty() || o.flutter.vg_stride) {
+    require(md.modes() >= 4, "the flutter part needs four modes (--modes 4 or more)");
+    structure::modal_data four = md;
+    four.omega.conservativeResize(4);
+    four.generalised_mass.conservativeResize(4);
+    four.shapes.resize(4);
+    csv_writer exp(o.out / "experiment.csv", "mach,density,speed,mass_ratio,fsi,frequency_ratio");
+    for (const auto& e : agard445_flutter::experiment())
+      exp.row({e.mach, e.density, e.speed, e.mass_ratio, e.fsi, e.frequency_ratio});
+    if (!o.flutter.strides.empty()) {
+      const auto runs = agard445_flutter::boundaries(o.flutter, o.out, w, go, four);
+      csv_writer costs(o.out / "costs.csv", "level,damping_percent,quantity,value");
+      for (const auto& r : runs) {
+        const flutter_boundary_costs c = boundary_costs(r.b, o.flutter.machs);
+        const std::string level = models::wing_family::level_name(r.stride);
+        double steady_mean = 0;
+        for (const auto& p : r.b.points) steady_mean += p.steady_seconds / double(r.b.points.size());
+        costs.row({level, r.damping, "hopf_per_steady_continued", c.hopf_per_steady});
+        costs.row({level, r.damping, "hopf_per_steady_listed", c.hopf_per_steady_listed});
+        costs.row({level, r.damping, "steady_seconds_mean", steady_mean});
+        costs.row({level, r.damping, "boundary_seconds", r.seconds});
+      }
+    }
+    if (o.flutter.vg_stride) agard445_flutter::vg(o.flutter, o.out, w, go, four);
+  }
   std::cout << "\nresults in " << o.out
             << " (modes.csv, mode_shapes.csv, modes.vtk, modal_data.csv, modes.bdf, modes.pch, grid_*.xyz, "
-               "grid_quality.csv, steady_*.csv, lift_slope.csv, surface_*.vtk; plot: python3 "
-            << "examples/agard445/plot_modes.py " << o.out.string() << ")\n";
+               "grid_quality.csv, steady_*.csv, lift_slope.csv, surface_*.vtk, boundary_*.csv, experiment.csv, costs.csv; "
+               "plots: python3 examples/agard445/plot_modes.py "
+            << o.out.string() << "; python3 examples/agard445/plot_flutter.py " << o.out.string() << ")\n";
   return ok ? 0 : 1;
 } catch (const std::exception& e) {
   std::cerr << "agard445: " << e.what() << "\n";

@@ -6,6 +6,7 @@
 
 #include <exception>
 #include <string>
+#include <vector>
 
 namespace example_cli {
 
@@ -26,6 +27,43 @@ class arguments {
   }
   double number() { return parsed<double>("a number", [](const std::string& v, std::size_t* u) { return std::stod(v, u); }); }
   int integer() { return parsed<int>("an integer", [](const std::string& v, std::size_t* u) { return std::stoi(v, u); }); }
+  /// A comma-separated list of numbers (at least one).
+  std::vector<double> numbers() {
+    const std::string v = value();
+    std::vector<double> out;
+    std::size_t from = 0;
+    while (true) {
+      const std::size_t comma = v.find(',', from);
+      const std::string item = v.substr(from, comma == std::string::npos ? std::string::npos : comma - from);
+      std::size_t used = 0;
+      double x = 0;
+      try {
+        x = std::stod(item, &used);
+      } catch (const std::exception&) {
+        used = 0;
+      }
+      if (item.empty() || used != item.size())
+        throw aerohopf::input_error(option_ + " takes a comma-separated list of numbers, not '" + v + "'");
+      out.push_back(x);
+      if (comma == std::string::npos) break;
+      from = comma + 1;
+    }
+    return out;
+  }
+  /// A comma-separated list of words (at least one, none empty).
+  std::vector<std::string> words() {
+    const std::string v = value();
+    std::vector<std::string> out;
+    std::size_t from = 0;
+    while (true) {
+      const std::size_t comma = v.find(',', from);
+      out.push_back(v.substr(from, comma == std::string::npos ? std::string::npos : comma - from));
+      if (out.back().empty()) throw aerohopf::input_error(option_ + " takes a comma-separated list, not '" + v + "'");
+      if (comma == std::string::npos) break;
+      from = comma + 1;
+    }
+    return out;
+  }
 
  private:
   /// The value converted by convert (std::stod-like), all of it used, else input_error.
