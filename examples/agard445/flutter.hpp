@@ -11,11 +11,15 @@
 #include <aerohopf/bifurcation/flutter_boundary.hpp>
 #include <aerohopf/bifurcation/vg_diagram.hpp>
 #include <aerohopf/io/csv.hpp>
+#include <aerohopf/linalg/krylov_solver.hpp>
+#include <aerohopf/time/eigenmode_march.hpp>
+#include <aerohopf/io/vtk.hpp>
 #include <aerohopf/models/wing_family.hpp>
 
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <complex>
 #include <cstdio>
 #include <filesystem>
 #include <map>
@@ -58,12 +62,14 @@ inline models::flutter_reference agard_reference(const flow::wing_planform& p) {
 }
 
 struct flutter_options {
-  std::vector<int> strides{4};              ///< boundary levels, coarse to fine (grid sequencing)
-  std::vector<double> damping_percent{0, 0.5, 2};
+  std::vector<int> strides{4, 2};           ///< boundary levels, coarse to fine (grid sequencing)
+  std::vector<double> damping_percent{0, 0.5, 2};  ///< on the coarsest level
+  std::vector<double> fine_damping_percent{0.5};   ///< on the finer levels (those also in damping_percent)
   std::vector<double> machs{0.499, 0.678, 0.901, 0.96};
   int vg_stride = 0;                        ///< 0: no V-g diagram
   double vg_mach = 0.96;
   int vg_points = 9;
+  int march_stride = 0;                     ///< 0: no time-marching verification
   bool verbose = false;
 };
 
@@ -84,6 +90,39 @@ inline std::pair<double, double> experimental_start(const models::wing_family& f
   const double ratio = (1 - t) * e[k].frequency_ratio + t * e[k + 1].frequency_ratio;
   const double c = f.planform().root_chord;
   return {rho * c * c * c, ratio * 239.3 * c / f.sound().speed(mach)};
+}
+
+/// The flutter mode of a boundary point for ParaView: the wall surface (deflected) with its Cp at
+/// four phases of the cycle, w = w0 + eps Re(e^{i phi} p), eps giving a largest grid
+/// displacement of 5 % of the root chord: flutter_mode_<tag>_phase<0..3>.vtk.
+inline void write_flutter_mode(const models::wing_system& s, const hopf_point& h, const std::filesystem::path& out,
+                               const std::string& tag) {
+  using cplx = std::complex<double>;
+  const Eigen::Index nf = s.flow_size(), m = s.modes();
+  const auto& rest = s.flow().grid().points.blocks[0];
+  auto largest_displacement = [&](const vec<double>& a) {
+    const auto moved = s.motion().points<double>(a);
+    double d = 0;
+    for (std::size_t k = 0; k < rest.x.size(); ++k) {
+      double e = 0;
+      for (int c = 0; c < 3; ++c) e += (moved.x[k][c] - rest.x[k][c]) * (moved.x[k][c] - rest.x[k][c]);
+      d = std::max(d, std::sqrt(e));
+    }
+    return d;
+  };
+  double peak = 0;
+  for (int k = 0; k < 4; ++k) {
+    const cplx rot = std::polar(1.0, k * std::numbers::pi / 4);  // the largest over the cycle, sampled
+    peak = std::max(peak, largest_displacement(vec<double>((rot * h.p.segment(nf, m)).real())));
+  }
+  require(peak > 0, "write_flutter_mode: the eigenvector does not move the wing");
+  const double eps = 0.05 / peak;
+  for (int k = 0; k < 4; ++k) {
+    const cplx rot = std::polar(eps, k * std::numbers::pi / 2);
+    const vec<double> w = h.w + vec<double>((rot * h.p).real());
+    io::write_vtk_wall_surface((out / ("flutter_mode_" + tag + "_phase" + std::to_string(k) + ".vtk")).string(),
+                               s.moved_flow(w), vec<double>(w.head(nf)));
+  }
 }
 
 struct boundary_run {
@@ -107,6 +146,10 @@ inline std::vector<boundary_run> boundaries(const flutter_options& o, const std:
                                      tunnel_schedule());
     const flutter_boundary* coarser = nullptr;
     for (int s : o.strides) {
+      const bool finer = s != o.strides.front();
+      if (finer && std::find(o.fine_damping_percent.begin(), o.fine_damping_percent.end(), zeta) ==
+                       o.fine_damping_percent.end())
+        continue;
       const std::string name = models::wing_family::level_name(s);
       std::printf("\n=== flutter boundary: %s grid, structural damping %g %%, %zu Mach numbers ===\n", name.c_str(), zeta,
                   o.machs.size());
@@ -135,6 +178,11 @@ inline std::vector<boundary_run> boundaries(const flutter_options& o, const std:
         std::printf("\n");
       }
       if (!r.b.complete) std::printf("  boundary incomplete: %s\n", r.b.stop_reason.c_str());
+      for (const auto& p : r.b.points)  // the flutter mode at M = 0.96
+        if (std::abs(p.mach - 0.96) < 1e-9) {
+          hopf_point h = p.point;
+          write_flutter_mode(family.system(s, p.mach), h, out, name + "_" + damping_tag(zeta) + "_M0.96");
+        }
       const flutter_boundary_costs c = boundary_costs(r.b, o.machs);
       std::printf("  %zu points in %.1f s; Hopf work per steady solve %.2f (continued points), %.2f (all work beyond "
                   "one steady solve per listed Mach number)\n",
@@ -145,6 +193,38 @@ inline std::vector<boundary_run> boundaries(const flutter_options& o, const std:
     }
   }
   return runs;
+}
+
+/// The Hopf point of one family member from the experiment's start (inverse power to 1e-3 as
+/// the driver's first point, then Newton-Krylov), with the system and its equilibrium.
+struct single_point {
+  models::wing_system s;
+  vec<double> w;
+  hopf_result h;
+  double steady_seconds = 0, hopf_seconds = 0;
+};
+inline single_point hopf_at(const models::wing_family& family, int stride, double mach) {
+  const auto t0 = std::chrono::steady_clock::now();
+  models::wing_system s = family.system(stride, mach);
+  vec<double> w = family.equilibrium(s, 0.0);
+  const auto t1 = std::chrono::steady_clock::now();
+  const auto [mu0, omega0] = experimental_start(family, mach);
+  const flutter_boundary_options fo = family.boundary_options();
+  hopf_start_krylov_options so;  // the driver's start: inverse power to 1e-3, each solve 10x tighter
+  so.fill_level = fo.fill_level;
+  so.krylov.restart = fo.start_restart;
+  so.inverse_power.tolerance = fo.start_eigen_tolerance;
+  so.krylov.relative_tolerance = 0.1 * fo.start_eigen_tolerance;
+  const hopf_point start = hopf_start_krylov<5>(s, w, mu0, omega0, so);
+  hopf_options ho;
+  ho.fixed_equilibrium = true;
+  ho.newton.abs_tolerance = fo.tolerance;
+  hopf_krylov_options hk = fo.krylov;
+  hk.fill_level = fo.fill_level;
+  hopf_result h = solve_hopf_krylov<5>(s, start, ho, hk);
+  const auto t2 = std::chrono::steady_clock::now();
+  return {std::move(s), std::move(w), std::move(h), std::chrono::duration<double>(t1 - t0).count(),
+          std::chrono::duration<double>(t2 - t1).count()};
 }
 
 /// V-g / V-f of the four modes at o.vg_mach on level o.vg_stride (no structural damping), over
@@ -160,22 +240,11 @@ inline void vg(const flutter_options& o, const std::filesystem::path& out, const
   std::fflush(stdout);
   const auto t0 = std::chrono::steady_clock::now();
   const models::wing_family family(wing, grid, {o.vg_stride}, modes, Eigen::VectorXd::Zero(1), tunnel_schedule());
-  const models::wing_system s = family.system(o.vg_stride, o.vg_mach);
-  const vec<double> w = family.equilibrium(s, 0.0);
-  const auto [mu0, omega0] = experimental_start(family, o.vg_mach);
-  flutter_boundary_options fo = family.boundary_options();
-  hopf_start_krylov_options so;  // the driver's start: inverse power to 1e-3, each solve 10x tighter
-  so.fill_level = fo.fill_level;
-  so.krylov.restart = fo.start_restart;
-  so.inverse_power.tolerance = fo.start_eigen_tolerance;
-  so.krylov.relative_tolerance = 0.1 * fo.start_eigen_tolerance;
-  const hopf_point start = hopf_start_krylov<5>(s, w, mu0, omega0, so);
-  hopf_options ho;
-  ho.fixed_equilibrium = true;
-  ho.newton.abs_tolerance = fo.tolerance;
-  hopf_krylov_options hk = fo.krylov;
-  hk.fill_level = fo.fill_level;
-  const hopf_result h = solve_hopf_krylov<5>(s, start, ho, hk);
+  const single_point sp = hopf_at(family, o.vg_stride, o.vg_mach);
+  const models::wing_system& s = sp.s;
+  const vec<double>& w = sp.w;
+  const hopf_result& h = sp.h;
+  const flutter_boundary_options fo = family.boundary_options();
   std::printf("  Hopf point mu* = %.6f, omega* = %.6f (%d Newton iterations)\n", h.point.mu, h.point.omega,
               h.report.iterations);
   std::vector<double> mus;
@@ -201,6 +270,77 @@ inline void vg(const flutter_options& o, const std::filesystem::path& out, const
   std::printf("  %d modes x %zu values: %d inverse powers, %ld GMRES iterations, %.1f s\n", r.modes, mus.size(),
               r.inverse_powers, r.linear_iterations,
               std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+}
+
+/// Time-marching verification (BDF2: three orders of the unsteady residual per step, the exact
+/// Jacobian frozen over a step, BILU(0)-GMRES with the structure bordered) at
+/// 0.95 and 1.05 mu* of the Hopf point at o.vg_mach on level `stride`, no structural damping:
+/// started on the critical eigenvector at that mu, 4 periods at 48 steps per period; the growth
+/// rate of the first modal coordinate against Re(lambda). verification.csv and
+/// history_M<mach>_<level>_<factor>.csv (t,a1,a2,a3,a4).
+inline void march(const flutter_options& o, int stride, const std::filesystem::path& out,
+                  const flow::wing_geometry& wing, const flow::wing_grid_options& grid,
+                  const structure::modal_data& modes) {
+  const std::string name = models::wing_family::level_name(stride);
+  std::printf("\n=== time marching at 0.95 / 1.05 mu*: %s grid, M = %.3f, no structural damping ===\n", name.c_str(),
+              o.vg_mach);
+  std::fflush(stdout);
+  const models::wing_family family(wing, grid, {stride}, modes, Eigen::VectorXd::Zero(1), tunnel_schedule());
+  const single_point sp = hopf_at(family, stride, o.vg_mach);
+  const Eigen::Index nf = sp.s.flow_size();
+  std::printf("  Hopf point mu* = %.6f, omega* = %.6f (steady %.1f s, Hopf %.1f s)\n", sp.h.point.mu, sp.h.point.omega,
+              sp.steady_seconds, sp.hopf_seconds);
+  csv_writer csv(out / "verification.csv",
+                 "grid,mach,mu_star,factor,mu,growth_rate,re_lambda,im_lambda,bdf2_rate,steps,march_seconds,"
+                 "steady_seconds");
+  const flutter_boundary_options fo = family.boundary_options();
+  for (double factor : {0.95, 1.05}) {
+    const double mu = factor * sp.h.point.mu;
+    // the critical eigenpair at this mu (inverse power from the Hopf eigenvalue and vector)
+    hopf_start_krylov_options so;
+    so.fill_level = fo.fill_level;
+    so.krylov.restart = fo.start_restart;
+    so.inverse_power.tolerance = 1e-8;
+    so.krylov.relative_tolerance = 1e-9;
+    eigen_pair ep;
+    (void)hopf_start_krylov<5>(sp.s, sp.w, mu, sp.h.point.omega, so, &ep);
+    eigenmode_march_options mo;
+    mo.coordinate = nf;  // the first modal coordinate (first bending)
+    mo.amplitude = 1e-4;
+    mo.cycles = 4;
+    mo.steps_per_period = 48;
+    // the inner matrix: the EXACT Jacobian, frozen over a step. With the modified-order one the
+    // chord iteration stalled (very coarse grid, dt = 0.77: ||R|| 8e-7 after 40 iterations);
+    // the time step of a wing's slow modes is large against the flow's.
+    mo.bdf2.approximate_jacobian = false;
+    krylov_solver_options ko;
+    ko.fill_level = 0;
+    ko.krylov.relative_tolerance = 1e-2;
+    ko.krylov.max_iterations = 400;
+    ko.krylov.record_history = false;
+    bordered_krylov_solver<Eigen::SparseMatrix<double>, 5> solver(sp.s.structure_size(), ko, "BDF2 inner BILU(0)-GMRES");
+    char tag[64];
+    std::snprintf(tag, sizeof tag, "M%.2f_%s_%.2f", o.vg_mach, name.c_str(), factor);
+    csv_writer hist(out / ("history_" + std::string(tag) + ".csv"), "t,a1,a2,a3,a4");
+    const auto t0 = std::chrono::steady_clock::now();
+    const eigenmode_march_result r =
+        march_eigenmode(sp.s, mu, sp.w, ep, mo, solver, [&](const bdf2_step_info& i, const vec<double>& w) {
+          hist.row({i.t, w[nf], w[nf + 1], w[nf + 2], w[nf + 3]});
+          if (i.step % 24 == 0) {
+            std::printf("    t = %7.2f  step %4ld  a1 = %+.4e  inner %d  ||R|| %.1e\n", i.t, i.step, w[nf], i.inner_iterations,
+                        i.inner_residual);
+            std::fflush(stdout);
+          }
+        });
+    const double sec = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    csv.row({name, o.vg_mach, sp.h.point.mu, factor, mu, r.growth_rate, r.re_lambda, r.im_lambda, r.bdf2_rate,
+             static_cast<long long>(r.steps), sec, sp.steady_seconds});
+    std::printf("  %.2f mu*: %s, growth rate %+.6f (%d peaks) vs Re(lambda) %+.6f (BDF2 at this dt: %+.6f); %ld steps, "
+                "%.1f s = %.0f steady solves\n",
+                factor, r.growth_rate < 0 ? "decays" : "grows", r.growth_rate, r.peaks, r.re_lambda, r.bdf2_rate, r.steps,
+                sec, sec / sp.steady_seconds);
+    std::fflush(stdout);
+  }
 }
 
 }  // namespace agard445_flutter

@@ -16,10 +16,12 @@
 //   --modes K      modes written (default 5; the flutter part uses the first four)
 //   --steady L     level of the steady solutions: very_coarse, coarse (default), medium, none
 //   --fine-grid    also write the fine level's Plot3D file (1.5 M points, 37 MB)
-//   --flutter L    boundary levels, coarse to fine, e.g. coarse,medium (default coarse; none)
-//   --damping P    structural damping ratios in percent (default 0,0.5,2)
+//   --flutter L    boundary levels, e.g. coarse,medium (default; none: no boundaries)
+//   --damping P    structural damping ratios in percent on the coarsest level (default 0,0.5,2)
+//   --fine-damping P   those of them also run on the finer levels (default 0.5)
 //   --machs LIST   Mach numbers of the boundaries (default 0.499,0.678,0.901,0.96, the experiment's)
 //   --vg L         V-g / V-f diagram on level L (default none)   --vg-mach M (default 0.96)
+//   --march L      time-marching verification at 0.95 / 1.05 mu* on level L at the V-g Mach number
 //   --verbose      a line per Newton iteration of the boundaries
 // Outputs under out_dir (default out/agard445):
 //   modes.csv          mode,frequency_hz,generalised_mass  (generalised mass of the mode scaled to a
@@ -40,6 +42,9 @@
 //   experiment.csv     mach,density,speed,mass_ratio,fsi,frequency_ratio (spec 06)
 //   vg_M<mach>_<level>.csv, vg_flutter_M<mach>_<level>.csv   the V-g diagram (parameter mu = rho c^3)
 //   costs.csv          level,damping_percent,quantity,value (Hopf work per steady solve, seconds)
+//   flutter_mode_<level>_zeta<percent>_M0.96_phase<k>.vtk   the flutter mode at M = 0.96: the wing
+//                      deflected (5 % of the root chord at most) and its Cp at phases k pi / 2
+//   verification.csv, history_M<mach>_<level>_<factor>.csv   time marching (--march)
 // Both exchange formats are read back and compared with the modes written (exit status 1 if not).
 // plot_modes.py in this folder turns mode_shapes.csv into modes.png, plot_flutter.py the
 // boundaries and the V-g diagram into flutter_boundary.png and vg.png.
@@ -116,10 +121,10 @@ options parse(int argc, char** argv) {
       for (const auto& l : args.words())
         if (l != "none") o.flutter.strides.push_back(stride_of(l));
       std::sort(o.flutter.strides.begin(), o.flutter.strides.end(), std::greater<>());
-    } else if (a == "--damping") {
-      o.flutter.damping_percent = args.numbers();
-      for (double z : o.flutter.damping_percent)
-        require(z >= 0 && z < 50, "--damping: percentages in [0, 50) (got ", z, ")");
+    } else if (a == "--damping" || a == "--fine-damping") {
+      auto& list = a == "--damping" ? o.flutter.damping_percent : o.flutter.fine_damping_percent;
+      list = args.numbers();
+      for (double z : list) require(z >= 0 && z < 50, a, ": percentages in [0, 50) (got ", z, ")");
     } else if (a == "--machs") {
       o.flutter.machs = args.numbers();
       for (std::size_t k = 0; k < o.flutter.machs.size(); ++k)
@@ -128,6 +133,9 @@ options parse(int argc, char** argv) {
     } else if (a == "--vg") {
       const std::string l = args.value();
       o.flutter.vg_stride = l == "none" ? 0 : stride_of(l);
+    } else if (a == "--march") {
+      const std::string l = args.value();
+      o.flutter.march_stride = l == "none" ? 0 : stride_of(l);
     } else if (a == "--vg-mach") {
       o.flutter.vg_mach = args.number();
       require(o.flutter.vg_mach > 0.3 && o.flutter.vg_mach < 1.3, "--vg-mach must lie in (0.3, 1.3)");
@@ -289,7 +297,7 @@ int main(int argc, char** argv) try {
     slope.row({o.steady, mach, euler, vlm, datcom});
   }
   // 4. the flutter boundaries and the V-g diagram (four modes)
-  if (!o.flutter.strides.empty() || o.flutter.vg_stride) {
+  if (!o.flutter.strides.empty() || o.flutter.vg_stride || o.flutter.march_stride) {
     require(md.modes() >= 4, "the flutter part needs four modes (--modes 4 or more)");
     structure::modal_data four = md;
     four.omega.conservativeResize(4);
@@ -313,6 +321,7 @@ int main(int argc, char** argv) try {
       }
     }
     if (o.flutter.vg_stride) agard445_flutter::vg(o.flutter, o.out, w, go, four);
+    if (o.flutter.march_stride) agard445_flutter::march(o.flutter, o.flutter.march_stride, o.out, w, go, four);
   }
   std::cout << "\nresults in " << o.out
             << " (modes.csv, mode_shapes.csv, modes.vtk, modal_data.csv, modes.bdf, modes.pch, grid_*.xyz, "

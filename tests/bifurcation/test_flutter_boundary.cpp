@@ -283,6 +283,23 @@ TEST(FlutterBoundary, BadInputIsRefused) {
   o.start_eigen_tolerance = NAN;
   EXPECT_TRUE(test::contains(test::input_error_of([&] { trace_flutter_boundary(f, 8, {0.5}, nullptr, o); }),
                              "start_eigen_tolerance"));
+  o = options_for(f, 1.66, 0.75, "bad");
+  o.mu_min = NAN;
+  EXPECT_TRUE(test::contains(test::input_error_of([&] { trace_flutter_boundary(f, 8, {0.5}, nullptr, o); }), "mu_min"));
+}
+
+TEST(FlutterBoundary, PointsBelowMuMinAreRefused) {
+  // the light very coarse boundary's first point lies at Ubar* ~ 1.7: with mu_min above it the
+  // converged point is refused, so there is no first point
+  const auto f = family(10.0);
+  flutter_boundary_options o = options_for(f, 1.66, 0.75, "mu_min");
+  o.mu_min = 5.0;
+  o.log = nullptr;
+  EXPECT_THROW(trace_flutter_boundary(f, 8, {0.5}, nullptr, o), convergence_error);
+  o.mu_min = 1.0;
+  const flutter_boundary b = trace_flutter_boundary(f, 8, {0.5}, nullptr, o);
+  ASSERT_EQ(b.points.size(), 1u);
+  EXPECT_GT(b.points[0].mu, 1.0);
 }
 
 }  // namespace

@@ -143,6 +143,16 @@ struct flutter_boundary_options {
   coarse_predictor predictor = coarse_predictor::automatic;
   /// mu enters the system only through mu^2 (the aerofoil's 1/Ubar^2): -mu* is the same point.
   bool parameter_even = false;
+  /// A point with mu* below this is refused (a failed attempt: the step is retried shorter).
+  /// A wing's density parameter: at mu = 0 the undamped in-vacuo modes are trivial Hopf points,
+  /// which a secant predictor through a falling boundary can land on (AGARD 445.6 coarse, no
+  /// damping, M = 0.678 -> 0.901: mu* = -1e-11).
+  double mu_min = -INFINITY;
+  /// mu > 0 along the boundary, varying by a large factor (a wing's density parameter: 9x from
+  /// M = 0.5 to 0.96 on AGARD 445.6): the predictors extrapolate log mu (the secant) and scale
+  /// by the coarser boundary's ratio (the increment) instead of differences, so a falling
+  /// boundary is not predicted through zero.
+  bool positive_parameter = false;
   /// The equilibrium moves with mu (e.g. a mean incidence: the static aeroelastic deflection
   /// depends on Ubar): each point is a FULL Hopf system solved by solve_hopf_krylov with
   /// hopf_krylov_options::full_system (no start refinement), the family's equilibrium(s, mu) is
@@ -309,6 +319,8 @@ inline void check_flutter_boundary_options(const flutter_boundary_options& o, co
   require(std::isfinite(o.start_omega) && o.start_omega > 0, where, ": start_omega must be finite and > 0 (got ",
           o.start_omega, ")");
   require(o.tolerance > 0 && std::isfinite(o.tolerance), where, ": tolerance must be > 0 (got ", o.tolerance, ")");
+  require(!std::isnan(o.mu_min) && o.mu_min < INFINITY, where, ": mu_min must be a number below infinity (got ",
+          o.mu_min, ")");
   require(o.fill_level >= 0, where, ": fill_level must be >= 0 (got ", o.fill_level, ")");
   require(o.max_iterations >= 1, where, ": max_iterations must be >= 1 (got ", o.max_iterations, ")");
   require(o.start_restart >= 1, where, ": start_restart must be >= 1 (got ", o.start_restart, ")");
@@ -568,6 +580,9 @@ class flutter_boundary_tracer {
     try {
       hopf_result h = o_.moving_equilibrium ? full_hopf(s, g, st.mu, ho, ko, label) : solve_hopf_krylov<B>(s, g, ho, ko);
       if (o_.parameter_even) h.point.mu = std::abs(h.point.mu);
+      if (!(h.point.mu >= o_.mu_min))
+        throw convergence_error(concat(label, ": converged to mu* = ", h.point.mu, " (omega* = ", h.point.omega,
+                                       "), below the admissible mu_min = ", o_.mu_min));
       if (o_.verbose)
         flutter_say(log_, "    %s: setup (assembly + BILU) %.3f s, GMRES %.3f s, residuals %.3f s\n", label.c_str(),
                     h.setup_seconds, h.linear_seconds, h.residual_seconds);
@@ -854,7 +869,8 @@ hopf_point flutter_boundary_tracer<F>::predict(const S& s, double m, const solve
     const auto& p1 = pts_[*i1];
     const auto& p2 = pts_.back();
     const double t = (m - p2.mach) / (p2.mach - p1.mach);
-    guess.mu = p2.mu + t * (p2.mu - p1.mu);
+    guess.mu = o_.positive_parameter && p1.mu > 0 && p2.mu > 0 ? p2.mu * std::pow(p2.mu / p1.mu, t)
+                                                                : p2.mu + t * (p2.mu - p1.mu);
     guess.omega = p2.omega + t * (p2.omega - p1.omega);
     // p1 in the normalisation of p2 (same value at p2's largest component), then the secant
     Eigen::Index k = 0;
@@ -872,7 +888,8 @@ hopf_point flutter_boundary_tracer<F>::predict(const S& s, double m, const solve
     const auto c0 = coarse_at(pts_.back().mach), c1 = coarse_at(m);
     if (c0 && c1 && cosine(c0->point, c1->point) >= o_.same_mode_cosine) {
       const flutter_boundary_point& p2 = pts_.back();
-      guess.mu = p2.mu + (c1->mu - c0->mu);
+      guess.mu = o_.positive_parameter && c0->mu > 0 && c1->mu > 0 ? p2.mu * (c1->mu / c0->mu)
+                                                                   : p2.mu + (c1->mu - c0->mu);
       guess.omega = p2.omega + (c1->omega - c0->omega);
       // the eigenvector from the coarser increment: always (full), never (values), or (automatic)
       // where the secant eigenvector's Hopf residual at the predicted mu, omega exceeds the start

@@ -197,6 +197,18 @@ class wing_system {
     return flow::compute_metrics<T, 3>(pts, &spd);
   }
 
+  /// The flow model on the grid moved to the modal state of w (points and speeds): the
+  /// deflected wing's surface for io::write_vtk_wall_surface, the flow part of the Jacobian.
+  flow::euler_model<3> moved_flow(const vec<double>& w) const {
+    require_size(w.size(), size(), "wing_system::moved_flow", "state");
+    flow::multiblock_points<double, 3> pts, spd;
+    pts.blocks.push_back(motion_.points<double>(w.segment(nf_, m_)));
+    spd.blocks.push_back(motion_.velocities<double>(w.segment(nf_ + m_, m_)));
+    flow::euler_model<3> moved = flow_;
+    moved.set_grid_motion(pts, &spd);
+    return moved;
+  }
+
   /// The generalised forces g (m entries, non-dimensional: by rho U^2 c^2 times root chords) of state w.
   template <class T>
   vec<T> generalised_forces(const vec<T>& w) const {
@@ -402,12 +414,7 @@ class wing_system {
     if (at_rest(w)) {
       flow::assemble_jacobian<3>(flow_, wf, kind, aff);
     } else {
-      flow::multiblock_points<double, 3> pts, spd;
-      pts.blocks.push_back(motion_.points<double>(w.segment(nf_, m_)));
-      spd.blocks.push_back(motion_.velocities<double>(w.segment(nf_ + m_, m_)));
-      flow::euler_model<3> moved = flow_;
-      moved.set_grid_motion(pts, &spd);
-      flow::assemble_jacobian<3>(moved, wf, kind, aff);
+      flow::assemble_jacobian<3>(moved_flow(w), wf, kind, aff);
     }
     if (coupling_from) {
       require(coupling_from->flow_size() == nf_ && coupling_from->structure_size() == 2 * m_,

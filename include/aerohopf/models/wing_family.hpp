@@ -190,7 +190,8 @@ class wing_family {
   static double parameter_of_factor(double q) { return q; }
 
   /// The driver's options for a wing: the tracer's metric mu / 0.005, M / 0.01, omega / 0.02
-  /// (AGARD 445.6: mu* 0.005-0.08, omega* 0.15-0.5), mu in [1e-4, 1]; the inverse-power start
+  /// (AGARD 445.6: mu* 0.005-0.08, omega* 0.15-0.5), mu in [1e-4, 1] (also for the continued
+  /// points: flutter_boundary_options::mu_min); the inverse-power start
   /// to 1e-3 (its solves are the dearest part of a first point: 110 s of 131 s on the coarse
   /// grid at 1e-8, measured) with GMRES(80) (GMRES(50) stagnated at a relative residual of 0.98
   /// on the coarse grid at M = 0.901, GMRES(80) converged); no trailing-block crossing check
@@ -199,6 +200,8 @@ class wing_family {
     flutter_boundary_options o;
     o.check_crossings = false;
     o.start_restart = 80;
+    o.mu_min = 1e-4;  // mu = 0: the undamped in-vacuo modes (flutter_boundary_options::mu_min)
+    o.positive_parameter = true;  // the secant in log mu (a linear one predicted mu < 0 past M = 0.68)
     hopf_curve_options& c = o.curve;
     c.mu_scale = 0.005;
     c.nu_scale = 0.01;
