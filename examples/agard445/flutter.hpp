@@ -250,11 +250,18 @@ inline void vg(const flutter_options& o, const std::filesystem::path& out, const
   std::vector<double> mus;
   for (int k = 0; k < o.vg_points; ++k) mus.push_back(h.point.mu * (0.4 + 0.8 * k / std::max(1, o.vg_points - 1)));
   vg_options vo;
-  vo.inverse_power.tolerance = 1e-8;
+  vo.inverse_power.tolerance = fo.scan_tolerance;  // 1e-7, each GMRES solve 10x tighter (the driver's scans)
+  vo.verbose = o.verbose;
   vg_krylov_options ko;
   ko.fill_level = fo.fill_level;
-  ko.krylov.relative_tolerance = 1e-9;
-  const auto starts = vg_mode_starts(s.structure().a_ss());
+  ko.krylov.relative_tolerance = 0.1 * fo.scan_tolerance;
+  ko.krylov.restart = fo.start_restart;  // GMRES(50) stagnates on the wing (wing_family::boundary_options)
+  ko.krylov.max_iterations = 4000;
+  // starts at the in-vacuo eigenvalues WITHOUT their shapes as start vectors: from a purely
+  // structural start vector the bordered BILU-GMRES solves stagnated (relative residual 0.99
+  // after 4,000 iterations, coarse grid, mu = 0.4 mu*), from the default start they converge
+  std::vector<vg_mode_start> starts = vg_mode_starts(s.structure().a_ss());
+  for (auto& st : starts) st.tracked = {};
   const vg_result r = vg_diagram(s, [&](double) { return w; }, mus, starts, vo, vg_krylov_solvers<5>(s, ko));
   csv_writer csv(out / ("vg_" + std::string(mtag) + "_" + name + ".csv"), "mode,parameter,damping_g,frequency,re,im");
   for (const auto& p : r.points)

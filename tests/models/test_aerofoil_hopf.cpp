@@ -15,7 +15,7 @@
 #include <aerohopf/flow/steady_solver.hpp>
 #include <aerohopf/models/aerofoil.hpp>
 
-#include <Eigen/Eigenvalues>
+#include "support/dense_spectrum.hpp"
 
 #include <complex>
 #include <iostream>
@@ -28,16 +28,7 @@ namespace {
 // Dense spectrum: the eigenvalue nearest target, and the largest real part of all others.
 std::pair<std::complex<double>, double> spectrum_near(const aerofoil_system& s, const vec<double>& w, double ubar,
                                                       std::complex<double> target) {
-  Eigen::EigenSolver<Eigen::MatrixXd> es(Eigen::MatrixXd(s.jacobian(w, ubar)), false);
-  const auto& ev = es.eigenvalues();
-  Eigen::Index best = 0;
-  for (Eigen::Index i = 1; i < ev.size(); ++i)
-    if (std::abs(ev[i] - target) < std::abs(ev[best] - target)) best = i;
-  double other = -1e300;
-  for (Eigen::Index i = 0; i < ev.size(); ++i)
-    if (std::abs(ev[i] - ev[best]) > 1e-9 && std::abs(ev[i] - std::conj(ev[best])) > 1e-9)
-      other = std::max(other, ev[i].real());
-  return {ev[best], other};
+  return test_support::eigenvalue_near(s.jacobian(w, ubar), target);
 }
 // The aerofoil seen only through the dynamical_system interface (Eigen sparse Jacobians): the
 // Krylov Hopf solver and the Hopf-curve tracer then take the from_sparse route instead of the

@@ -16,7 +16,8 @@
 #include <aerohopf/nonlinear/check_jacobian.hpp>
 #include <aerohopf/structure/wing_plate.hpp>
 
-#include <Eigen/Eigenvalues>
+#include "support/dense_spectrum.hpp"
+#include "support/wing_cases.hpp"
 
 #include <cmath>
 #include <complex>
@@ -27,37 +28,13 @@ using namespace aerohopf;
 using models::wing_system;
 
 namespace {
-const flow::wing_geometry& agard() {
-  static const flow::wing_geometry w = flow::agard445_6();
-  return w;
-}
-flow::wing_grid_options tiny_options() {
-  flow::wing_grid_options o;
-  o.wake_cells = 2;
-  o.section_cells = 6;
-  o.normal_cells = 4;
-  o.span_cells = 4;
-  o.outboard_cells = 2;
-  o.multiple = 1;
-  o.first_height = 0.02;
-  o.far_field = 6;
-  o.redistribution_passes = 5;
-  return o;
-}
+using test_support::agard;
+flow::wing_grid_options tiny_options() { return test_support::tiny_wing_options(); }
 const flow::multiblock_grid<3>& tiny_grid() {
   static const flow::multiblock_grid<3> g = flow::wing_cgrid(agard(), tiny_options());
   return g;
 }
-const structure::modal_data& plate_modes() {
-  static const structure::modal_data d = [] {
-    const structure::plate_mesh pm = structure::wing_plate_mesh(agard(), 8, 8);
-    const auto km = structure::assemble_plate(pm, structure::agard445_6_mahogany(agard().planform));
-    structure::plate_mode_options mo;
-    mo.count = 4;
-    return structure::modal_data_from_plate(pm, structure::plate_modes_of(km, structure::clamped_root(pm, 8), mo));
-  }();
-  return d;
-}
+const structure::modal_data& plate_modes() { return test_support::agard_plate_modes(); }
 coupling::wing_modal_motion motion_of(const structure::modal_data& d) {
   coupling::wing_motion_options o;
   o.length_scale = agard().planform.root_chord;
@@ -238,19 +215,7 @@ TEST(wing_system, flutter_point_is_where_the_dense_spectrum_crosses_the_axis) {
   const vec<std::complex<double>> p = hk.point.p;
   EXPECT_LT((ac * p - std::complex<double>(0, omega) * p).norm(), 1e-8 * p.norm());
   // the dense spectrum 2 % below and above: the critical pair crosses, everything else is stable
-  auto near = [&](double at) {
-    Eigen::EigenSolver<Eigen::MatrixXd> es(Eigen::MatrixXd(s.jacobian(w, at)), false);
-    const auto& ev = es.eigenvalues();
-    const std::complex<double> target(0, omega);
-    Eigen::Index best = 0;
-    for (Eigen::Index i = 1; i < ev.size(); ++i)
-      if (std::abs(ev[i] - target) < std::abs(ev[best] - target)) best = i;
-    double other = -1e300;
-    for (Eigen::Index i = 0; i < ev.size(); ++i)
-      if (std::abs(ev[i] - ev[best]) > 1e-9 && std::abs(ev[i] - std::conj(ev[best])) > 1e-9)
-        other = std::max(other, ev[i].real());
-    return std::pair{ev[best], other};
-  };
+  auto near = [&](double at) { return test_support::eigenvalue_near(s.jacobian(w, at), {0.0, omega}); };
   const auto [below, other_below] = near(0.98 * mu);
   const auto [above, other_above] = near(1.02 * mu);
   std::cout << "critical eigenvalue at 0.98 mu*: " << below << ", at 1.02 mu*: " << above

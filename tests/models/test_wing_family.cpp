@@ -11,6 +11,8 @@
 #include <aerohopf/models/wing_family.hpp>
 #include <aerohopf/structure/wing_plate.hpp>
 
+#include "support/wing_cases.hpp"
+
 #include <cmath>
 #include <iostream>
 
@@ -18,33 +20,9 @@ using namespace aerohopf;
 using models::wing_family;
 
 namespace {
-const flow::wing_geometry& agard() {
-  static const flow::wing_geometry w = flow::agard445_6();
-  return w;
-}
-flow::wing_grid_options tiny_options() {
-  flow::wing_grid_options o;
-  o.wake_cells = 2;
-  o.section_cells = 6;
-  o.normal_cells = 4;
-  o.span_cells = 4;
-  o.outboard_cells = 2;
-  o.multiple = 1;
-  o.first_height = 0.02;
-  o.far_field = 6;
-  o.redistribution_passes = 5;
-  return o;
-}
-const structure::modal_data& plate_modes() {
-  static const structure::modal_data d = [] {
-    const structure::plate_mesh pm = structure::wing_plate_mesh(agard(), 8, 8);
-    const auto km = structure::assemble_plate(pm, structure::agard445_6_mahogany(agard().planform));
-    structure::plate_mode_options mo;
-    mo.count = 4;
-    return structure::modal_data_from_plate(pm, structure::plate_modes_of(km, structure::clamped_root(pm, 8), mo));
-  }();
-  return d;
-}
+using test_support::agard;
+flow::wing_grid_options tiny_options() { return test_support::tiny_wing_options(); }
+const structure::modal_data& plate_modes() { return test_support::agard_plate_modes(); }
 /// Spec 06: M, density, speed, mass ratio, FSI, omega_f / omega_alpha.
 constexpr double table[4][6] = {{0.499, 0.4278, 172.46, 33.465, 0.4459, 0.5353},
                                 {0.678, 0.2082, 231.37, 68.753, 0.4174, 0.4722},
@@ -160,4 +138,29 @@ TEST(wing_family, flutter_boundary_driver_runs_on_the_wing) {
   EXPECT_NEAR(b.points[0].omega, h.point.omega, 1e-6);
   // one mode all along (the structural parts continue each other)
   for (std::size_t k = 1; k < b.points.size(); ++k) EXPECT_GT(b.points[k].cosine, 0.9);
+}
+
+TEST(wing_family, log_secant_predicts_a_falling_boundary_without_crossing_zero) {
+  // the density parameter falls steeply with Mach number: with the secant in log mu
+  // (positive_parameter, the family's default) every listed Mach number is reached from the
+  // previous point in one attempt; the linear secant's prediction at the last one is below the
+  // log one's (here: the tiny grid's points, 0.5 -> 0.9)
+  const wing_family f(agard(), tiny_options(), {1}, plate_modes(), Eigen::VectorXd::Zero(1), tunnel());
+  flutter_boundary_options o = f.boundary_options();
+  ASSERT_TRUE(o.positive_parameter);
+  ASSERT_EQ(o.mu_min, 1e-4);
+  o.start_mu = 0.075;
+  o.start_omega = 0.4;
+  o.log = nullptr;
+  const flutter_boundary b = trace_flutter_boundary(f, 1, {0.5, 0.7, 0.9}, nullptr, o);
+  ASSERT_TRUE(b.complete) << b.stop_reason;
+  ASSERT_EQ(b.points.size(), 3u);
+  for (const auto& a : b.attempts) EXPECT_EQ(a.outcome, "accepted") << "M = " << a.mach << ": " << a.outcome;
+  EXPECT_EQ(b.attempts.size(), 3u);
+  const auto& p = b.points;
+  const double t = (p[2].mach - p[1].mach) / (p[1].mach - p[0].mach);
+  const double linear = p[1].mu + t * (p[1].mu - p[0].mu), logarithmic = p[1].mu * std::pow(p[1].mu / p[0].mu, t);
+  std::cout << "mu*: " << p[0].mu << ", " << p[1].mu << ", " << p[2].mu << "; predicted at M = 0.9: linear " << linear
+            << ", log " << logarithmic << "\n";
+  EXPECT_LT(std::abs(logarithmic - p[2].mu), std::abs(linear - p[2].mu));
 }

@@ -440,6 +440,23 @@ class euler_model {
     return qb;
   }
 
+  /// A wall face that carries loads (its patch tagged options().force_tag, every wall if that is
+  /// empty) with the two cells whose pressures make its wall pressure (3 p_0 - p_1) / 2.
+  struct loaded_face {
+    int block, dir, sign;     // as the halo's: normal axis, +1 if +dir points out of the block
+    std::size_t face;         // index among the block's faces normal to dir
+    Eigen::Index cell0, cell1;  // the wall cell and the next one inwards (global cell indices)
+  };
+  std::vector<loaded_face> loaded_faces() const {
+    std::vector<loaded_face> out;
+    for (const auto& h : halos_) {
+      if (h.kind != boundary_kind::wall || padded_layer(h) != 0 || !tagged(h.patch)) continue;
+      out.push_back({h.block, h.dir, h.sign, h.face, static_cast<Eigen::Index>(offset_[h.donor_block] + h.donor),
+                     static_cast<Eigen::Index>(offset_[h.donor_block] + h.donor2)});
+    }
+    return out;
+  }
+
   /// Wall pressures (Osher star pressure at each wall face) and force coefficients.
   struct wall_face {
     int block;

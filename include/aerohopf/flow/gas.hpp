@@ -52,6 +52,14 @@ primitive<S, Dim> to_primitive(const state<S, Dim>& w) {
   return q;
 }
 
+/// The pressure of the conservative state at w[0 .. Dim + 1] (a cell of a state vector).
+template <class S, int Dim>
+S pressure_at(const S* w) {
+  state<S, Dim> s;
+  for (int v = 0; v < Dim + 2; ++v) s[v] = w[v];
+  return to_primitive<S, Dim>(s).p;
+}
+
 template <class S, int Dim>
 state<S, Dim> to_conservative(const primitive<S, Dim>& q) {
   state<S, Dim> w;

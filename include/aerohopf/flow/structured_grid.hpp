@@ -65,6 +65,18 @@ struct grid_block {
   const std::array<S, Dim>& at(const index_d<Dim>& i) const { return x[linear_index<Dim>(i, points)]; }
 };
 
+/// The name of the level a grid family makes by coarsening its finest grid by `stride`:
+/// 8 very_coarse, 4 coarse, 2 medium, 1 fine, else "stride<s>".
+inline std::string level_name(int stride) {
+  switch (stride) {
+    case 8: return "very_coarse";
+    case 4: return "coarse";
+    case 2: return "medium";
+    case 1: return "fine";
+    default: return "stride" + std::to_string(stride);
+  }
+}
+
 template <class S, int Dim>
 struct multiblock_points {
   std::vector<grid_block<S, Dim>> blocks;

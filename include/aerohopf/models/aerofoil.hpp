@@ -73,20 +73,7 @@ class aerofoil_system {
     const auto& sp = structure_.parameters();
     ea_ = {sp.x_ea, sp.y_ea};
     nf_ = flow_.size();
-    const auto& opt = flow_.options();
-    const auto& topo = flow_.grid().topology;
-    for (const auto& h : flow_.halos()) {
-      if (h.kind != flow::boundary_kind::wall || flow_.padded_layer(h) != 0) continue;
-      if (!opt.force_tag.empty() && topo.patches[h.patch].tag != opt.force_tag) continue;
-      wall_face f;
-      f.block = h.block;
-      f.dir = h.dir;
-      f.face = h.face;
-      f.sign = h.sign;
-      f.cell0 = static_cast<Eigen::Index>(flow_.cell_offset(h.donor_block) + h.donor);
-      f.cell1 = static_cast<Eigen::Index>(flow_.cell_offset(h.donor_block) + h.donor2);
-      walls_.push_back(f);
-    }
+    walls_ = flow_.loaded_faces();
     require(!walls_.empty(), "aerofoil_system: the flow grid has no wall faces to integrate loads over");
     // mid-point of every rest face relative to the elastic axis (the moved metrics and the loads)
     const auto& rest = flow_.metrics();
@@ -313,37 +300,15 @@ class aerofoil_system {
   }
 
  private:
-  /// Size and finiteness of a state and Ubar in any scalar (for a jet: its value parts), before
-  /// the grid is moved: a NaN pose would give NaN metrics and a NaN residual without a word.
   template <class T>
   void check_entry(const vec<T>& w, const T& mu, const char* who) const {
-    require_size(w.size(), size(), who, "state");
-    const double m = to_double(mu);
-    require(std::isfinite(m), who, ": parameter Ubar is not finite (", m, ")");
-    for (Eigen::Index i = 0; i < w.size(); ++i) {
-      const double x = to_double(w[i]);
-      if (!std::isfinite(x))
-        throw input_error(internal::concat(who, ": state entry ", i, " of ", w.size(), " is not finite (", x, ")",
-                                           i < nf_ ? internal::concat(", flow cell ", i / nv)
-                                                   : internal::concat(", structural unknown ", i - nf_)));
-    }
+    require_finite_aeroelastic_state(w, mu, size(), nf_, nv, who, "Ubar");
   }
   static const char* who_of(flow::jacobian_kind kind) {
     return kind == flow::jacobian_kind::exact ? "aerofoil_system::jacobian" : "aerofoil_system::approximate_jacobian";
   }
 
-  struct wall_face {
-    int block, dir, sign;
-    std::size_t face;
-    Eigen::Index cell0, cell1;  // wall cell and the next one inwards (global cell indices)
-  };
-
-  template <class T>
-  static T pressure_of(const T* wc) {
-    flow::state<T, 2> s;
-    for (int v = 0; v < nv; ++v) s[v] = wc[v];
-    return flow::to_primitive<T, 2>(s).p;
-  }
+  using wall_face = flow::euler_model<2>::loaded_face;
 
   /// Load of one wall face: (dC_l, dC_m) per unit (p_w - p_inf) and the face's lever arm.
   template <class T>
@@ -365,7 +330,7 @@ class aerofoil_system {
     const T pinf = T(flow_.conditions().pressure());
     T cl = T(0.0), cm = T(0.0);
     for (const auto& f : walls_) {
-      const T p0 = pressure_of<T>(w.data() + f.cell0 * nv), p1 = pressure_of<T>(w.data() + f.cell1 * nv);
+      const T p0 = flow::pressure_at<T, 2>(w.data() + f.cell0 * nv), p1 = flow::pressure_at<T, 2>(w.data() + f.cell1 * nv);
       const T dp = T(1.5) * p0 - T(0.5) * p1 - pinf;
       const auto [l, c] = face_load_per_pressure<T>(m, rot, f);
       cl += l * dp;
@@ -436,7 +401,7 @@ class aerofoil_system {
         const double weight = which == 0 ? 1.5 : -0.5;
         std::array<cjet, nv> wc;
         for (int u = 0; u < nv; ++u) wc[u] = cjet::variable(w[cell * nv + u], u);
-        const cjet p = pressure_of<cjet>(wc.data());
+        const cjet p = flow::pressure_at<cjet, 2>(wc.data());
         for (int v = 0; v < nv; ++v) {
           const double dp = weight * p.derivative(v);
           for (int i = 0; i < 4; ++i) sf(i, cell * nv + v) += (minv(i, 1) * kl * l + minv(i, 3) * km * c) * dp;

@@ -48,15 +48,7 @@ class aerofoil_family {
                            structure::pitch_plunge(structure_));
   }
 
-  static std::string level_name(int stride) {
-    switch (stride) {
-      case 8: return "very_coarse";
-      case 4: return "coarse";
-      case 2: return "medium";
-      case 1: return "fine";
-      default: return "stride" + std::to_string(stride);
-    }
-  }
+  static std::string level_name(int stride) { return flow::level_name(stride); }
 
   /// The equilibrium of s at Ubar: at zero incidence the steady flow from the free stream with
   /// the section at rest (aerofoil_system::steady_equilibrium: throws convergence_error if the

@@ -86,21 +86,12 @@ class wing_system {
             grid.points.blocks[0].n_points(), " points vs ", motion_.basis(0).size(), ")");
     nf_ = flow_.size();
     m_ = structure_.modes();
-    const auto& topo = grid.topology;
     const auto& rest = flow_.metrics();
     const auto& g = grid.points.blocks[0];
-    for (const auto& h : flow_.halos()) {
-      if (h.kind != flow::boundary_kind::wall || flow_.padded_layer(h) != 0) continue;
-      if (topo.patches[h.patch].tag != opt.force_tag) continue;
-      wall_face f;
-      f.block = h.block;
-      f.dir = h.dir;
-      f.face = h.face;
-      f.sign = h.sign;
-      f.cell0 = static_cast<Eigen::Index>(flow_.cell_offset(h.donor_block) + h.donor);
-      f.cell1 = static_cast<Eigen::Index>(flow_.cell_offset(h.donor_block) + h.donor2);
+    walls_ = flow_.loaded_faces();
+    for (const auto& f : walls_) {
       const auto corners =
-          flow::internal::face_corners<3>(h.dir, flow::unravel<3>(h.face, rest.blocks[h.block].face_dims(h.dir)));
+          flow::internal::face_corners<3>(f.dir, flow::unravel<3>(f.face, rest.blocks[f.block].face_dims(f.dir)));
       for (Eigen::Index i = 0; i < m_; ++i) {
         std::array<double, 3> mean{};
         for (const auto& c : corners) {
@@ -109,7 +100,6 @@ class wing_system {
         }
         face_mode_.push_back(mean);
       }
-      walls_.push_back(f);
     }
     require(!walls_.empty(), who, ": the flow grid has no wall faces tagged \"", opt.force_tag, "\"");
   }
@@ -272,11 +262,7 @@ class wing_system {
   }
 
  private:
-  struct wall_face {
-    int block, dir, sign;
-    std::size_t face;
-    Eigen::Index cell0, cell1;  // wall cell and the next one inwards (global cell indices)
-  };
+  using wall_face = flow::euler_model<3>::loaded_face;
   struct coupling_blocks {
     Eigen::MatrixXd fs, ss;  // [A_fs; A_ss] (nf x 2m, 2m x 2m)
   };
@@ -299,23 +285,7 @@ class wing_system {
 
   template <class T>
   void check_entry(const vec<T>& w, const T& mu, const char* who) const {
-    require_size(w.size(), size(), who, "state");
-    const double mv = to_double(mu);
-    require(std::isfinite(mv), who, ": parameter mu is not finite (", mv, ")");
-    for (Eigen::Index i = 0; i < w.size(); ++i) {
-      const double x = to_double(w[i]);
-      if (!std::isfinite(x))
-        throw input_error(internal::concat(who, ": state entry ", i, " of ", w.size(), " is not finite (", x, ")",
-                                           i < nf_ ? internal::concat(", flow cell ", i / nv)
-                                                   : internal::concat(", structural unknown ", i - nf_)));
-    }
-  }
-
-  template <class T>
-  static T pressure_of(const T* wc) {
-    flow::state<T, 3> s;
-    for (int v = 0; v < nv; ++v) s[v] = wc[v];
-    return flow::to_primitive<T, 3>(s).p;
+    require_finite_aeroelastic_state(w, mu, size(), nf_, nv, who, "mu");
   }
 
   /// c_fi = S_f . Psi_i(f) of wall face f (outward from the fluid) on metrics m.
@@ -333,7 +303,7 @@ class wing_system {
     vec<T> g = vec<T>::Constant(m_, T(0.0));
     for (std::size_t f = 0; f < walls_.size(); ++f) {
       const auto& wf = walls_[f];
-      const T dp = T(1.5) * pressure_of<T>(w.data() + wf.cell0 * nv) - T(0.5) * pressure_of<T>(w.data() + wf.cell1 * nv) - pinf;
+      const T dp = T(1.5) * flow::pressure_at<T, 3>(w.data() + wf.cell0 * nv) - T(0.5) * flow::pressure_at<T, 3>(w.data() + wf.cell1 * nv) - pinf;
       for (Eigen::Index i = 0; i < m_; ++i) g[i] += dp * face_work<T>(m, f, i);
     }
     return g;
@@ -351,7 +321,7 @@ class wing_system {
         const double weight = which == 0 ? 1.5 : -0.5;
         std::array<cjet, nv> wc;
         for (int u = 0; u < nv; ++u) wc[u] = cjet::variable(w[cell * nv + u], u);
-        const cjet p = pressure_of<cjet>(wc.data());
+        const cjet p = flow::pressure_at<cjet, 3>(wc.data());
         for (Eigen::Index i = 0; i < m_; ++i) {
           const double c = weight * face_work<double>(m, f, i);
           for (int v = 0; v < nv; ++v) gf(i, cell * nv + v) += c * p.derivative(v);

@@ -152,15 +152,7 @@ class wing_family {
                                                                  sound_.speed(mach)));
   }
 
-  static std::string level_name(int stride) {
-    switch (stride) {
-      case 8: return "very_coarse";
-      case 4: return "coarse";
-      case 2: return "medium";
-      case 1: return "fine";
-      default: return "stride" + std::to_string(stride);
-    }
-  }
+  static std::string level_name(int stride) { return flow::level_name(stride); }
 
   /// The steady flow about the wing at rest (wing_system::steady_equilibrium), the same for every mu.
   vec<double> equilibrium(const wing_system& s, double /*mu*/) const { return s.steady_equilibrium(steady_); }

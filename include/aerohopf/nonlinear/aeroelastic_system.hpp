@@ -18,11 +18,13 @@
 //       // (double states, complex eigenvectors); refuses a v of another size.
 #include <Eigen/Core>
 
+#include <cmath>
 #include <complex>
 #include <concepts>
 #include <string>
 
 #include "../error.hpp"
+#include "../scalar/traits.hpp"
 #include "system.hpp"
 
 namespace aerohopf {
@@ -44,6 +46,25 @@ void check_aeroelastic_layout(const S& s, const std::string& who) {
   const Eigen::Index nf = s.flow_size(), ns = s.structure_size(), n = s.size();
   require(nf >= 0 && ns > 0 && nf + ns == n, who, ": aeroelastic layout of ", nf, " flow and ", ns,
           " structural entries does not make up the system's ", n, " unknowns");
+}
+
+/// Size and finiteness of a state w (size n: nf flow entries in cells of nv, then the structure)
+/// and of the parameter, in any scalar (for a jet or Taylor number: its value), before a model
+/// moves its grid with them: a NaN structural state would give NaN metrics and a NaN residual
+/// without a word. input_error names `who`, the entry and its flow cell or structural unknown.
+template <class T>
+void require_finite_aeroelastic_state(const vec<T>& w, const T& mu, Eigen::Index n, Eigen::Index nf, int nv,
+                                      const char* who, const char* parameter) {
+  require_size(w.size(), n, who, "state");
+  const double m = to_double(mu);
+  require(std::isfinite(m), who, ": parameter ", parameter, " is not finite (", m, ")");
+  for (Eigen::Index i = 0; i < w.size(); ++i) {
+    const double x = to_double(w[i]);
+    if (!std::isfinite(x))
+      throw input_error(internal::concat(who, ": state entry ", i, " of ", w.size(), " is not finite (", x, ")",
+                                         i < nf ? internal::concat(", flow cell ", i / nv)
+                                                : internal::concat(", structural unknown ", i - nf)));
+  }
 }
 
 /// |a^H b| / (||a|| ||b||) of two structural parts: 1 for the same structural shape up to a
