@@ -13,8 +13,8 @@
 #include <aerohopf/io/csv.hpp>
 #include <aerohopf/linalg/krylov_solver.hpp>
 #include <aerohopf/time/eigenmode_march.hpp>
-#include <aerohopf/io/vtk.hpp>
 #include <aerohopf/models/wing_family.hpp>
+#include <aerohopf/models/wing_vtk.hpp>
 
 #include <algorithm>
 #include <chrono>
@@ -92,39 +92,6 @@ inline std::pair<double, double> experimental_start(const models::wing_family& f
   return {rho * c * c * c, ratio * 239.3 * c / f.sound().speed(mach)};
 }
 
-/// The flutter mode of a boundary point for ParaView: the wall surface (deflected) with its Cp at
-/// four phases of the cycle, w = w0 + eps Re(e^{i phi} p), eps giving a largest grid
-/// displacement of 5 % of the root chord: flutter_mode_<tag>_phase<0..3>.vtk.
-inline void write_flutter_mode(const models::wing_system& s, const hopf_point& h, const std::filesystem::path& out,
-                               const std::string& tag) {
-  using cplx = std::complex<double>;
-  const Eigen::Index nf = s.flow_size(), m = s.modes();
-  const auto& rest = s.flow().grid().points.blocks[0];
-  auto largest_displacement = [&](const vec<double>& a) {
-    const auto moved = s.motion().points<double>(a);
-    double d = 0;
-    for (std::size_t k = 0; k < rest.x.size(); ++k) {
-      double e = 0;
-      for (int c = 0; c < 3; ++c) e += (moved.x[k][c] - rest.x[k][c]) * (moved.x[k][c] - rest.x[k][c]);
-      d = std::max(d, std::sqrt(e));
-    }
-    return d;
-  };
-  double peak = 0;
-  for (int k = 0; k < 4; ++k) {
-    const cplx rot = std::polar(1.0, k * std::numbers::pi / 4);  // the largest over the cycle, sampled
-    peak = std::max(peak, largest_displacement(vec<double>((rot * h.p.segment(nf, m)).real())));
-  }
-  require(peak > 0, "write_flutter_mode: the eigenvector does not move the wing");
-  const double eps = 0.05 / peak;
-  for (int k = 0; k < 4; ++k) {
-    const cplx rot = std::polar(eps, k * std::numbers::pi / 2);
-    const vec<double> w = h.w + vec<double>((rot * h.p).real());
-    io::write_vtk_wall_surface((out / ("flutter_mode_" + tag + "_phase" + std::to_string(k) + ".vtk")).string(),
-                               s.moved_flow(w), vec<double>(w.head(nf)));
-  }
-}
-
 struct boundary_run {
   int stride = 0;
   double damping = 0;
@@ -180,8 +147,8 @@ inline std::vector<boundary_run> boundaries(const flutter_options& o, const std:
       if (!r.b.complete) std::printf("  boundary incomplete: %s\n", r.b.stop_reason.c_str());
       for (const auto& p : r.b.points)  // the flutter mode at M = 0.96
         if (std::abs(p.mach - 0.96) < 1e-9) {
-          hopf_point h = p.point;
-          write_flutter_mode(family.system(s, p.mach), h, out, name + "_" + damping_tag(zeta) + "_M0.96");
+          models::write_flutter_mode_vtk(family.system(s, p.mach), p.point,
+                                         (out / ("flutter_mode_" + name + "_" + damping_tag(zeta) + "_M0.96")).string());
         }
       const flutter_boundary_costs c = boundary_costs(r.b, o.machs);
       std::printf("  %zu points in %.1f s; Hopf work per steady solve %.2f (continued points), %.2f (all work beyond "
