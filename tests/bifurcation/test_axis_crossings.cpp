@@ -1,7 +1,8 @@
 // imaginary_axis_crossings against dense eigen-decompositions: on a small random system every
 // reported crossing is an eigenvalue on the axis, and every change of the number of unstable
-// eigenvalues along a fine q scan is explained by a reported crossing (or the divergence root);
-// on the aerofoil (very coarse grid, light case, M = 0.5) the lowest crossing is the Hopf point
+// eigenvalues along a fine q scan is explained by a reported crossing (or the divergence root),
+// with B confined to the structural block and with B reaching into the flow columns (as the
+// wing's generalised forces do; split_affine recovers both parts); on the aerofoil (very coarse grid, light case, M = 0.5) the lowest crossing is the Hopf point
 // of the augmented Newton solver.
 #include <gtest/gtest.h>
 
@@ -24,13 +25,16 @@ namespace {
 struct toy {
   Eigen::SparseMatrix<double> a0;
   Eigen::MatrixXd b_ss;
+  Eigen::SparseMatrix<double> b_sf;  // empty unless flow_columns
   Eigen::MatrixXd dense(double q) const {
     Eigen::MatrixXd a = Eigen::MatrixXd(a0);
     a.bottomRightCorner(4, 4) += q * b_ss;
+    if (b_sf.size() != 0) a.bottomLeftCorner(4, b_sf.cols()) += q * Eigen::MatrixXd(b_sf);
     return a;
   }
 };
-toy make_toy() {
+// flow_columns: the oscillators' forces also depend on q times the first ten fluid unknowns
+toy make_toy(bool flow_columns = false) {
   const int nf = 40, n = nf + 4;
   std::mt19937 gen(7);
   std::uniform_real_distribution<double> u(-1.0, 1.0);
@@ -54,6 +58,14 @@ toy make_toy() {
   t.b_ss = Eigen::Matrix4d::Zero();
   t.b_ss(1, 0) = -1;
   t.b_ss(3, 2) = -2;
+  if (flow_columns) {
+    Eigen::MatrixXd bsf = Eigen::MatrixXd::Zero(4, nf);
+    for (int j = 0; j < 10; ++j) {
+      bsf(1, j) = 0.05 * u(gen);
+      bsf(3, j) = 0.05 * u(gen);
+    }
+    t.b_sf = bsf.sparseView();
+  }
   return t;
 }
 int unstable_count(const Eigen::MatrixXd& a) {
@@ -64,13 +76,13 @@ int unstable_count(const Eigen::MatrixXd& a) {
 }
 }  // namespace
 
-TEST(axis_crossings, every_crossing_is_an_axis_eigenvalue_and_every_stability_change_a_crossing) {
-  const toy t = make_toy();
+namespace {
+void check_toy(const toy& t, const char* name) {
   axis_crossing_options o;
   o.omega_min = 1e-3;
   o.omega_max = 6.0;
   o.samples = 3000;
-  const axis_crossing_result r = imaginary_axis_crossings(t.a0, t.b_ss, o);
+  const axis_crossing_result r = imaginary_axis_crossings(t.a0, t.b_ss, t.b_sf, o);
   EXPECT_EQ(r.rank, 2);
   ASSERT_FALSE(r.crossings.empty());
   for (const auto& c : r.crossings) {
@@ -103,16 +115,58 @@ TEST(axis_crossings, every_crossing_is_an_axis_eigenvalue_and_every_stability_ch
     }
     prev = now;
   }
-  std::cout << "toy: " << r.crossings.size() << " crossings (" << r.rejected << " rejected), " << changes
+  std::cout << name << ": " << r.crossings.size() << " crossings (" << r.rejected << " rejected), " << changes
             << " stability changes on the q scan, " << explained << " explained, " << r.factorisations
             << " factorisations\n";
   EXPECT_GE(changes, 1);
+}
 
+}  // namespace
+
+TEST(axis_crossings, every_crossing_is_an_axis_eigenvalue_and_every_stability_change_a_crossing) {
+  const toy t = make_toy();
+  check_toy(t, "toy");
+  axis_crossing_options o;
+  o.omega_min = 1e-3;
+  o.omega_max = 6.0;
   axis_crossing_options bad = o;
   bad.omega_max = 0;
   EXPECT_THROW(imaginary_axis_crossings(t.a0, t.b_ss, bad), input_error);
   EXPECT_THROW(imaginary_axis_crossings(t.a0, Eigen::MatrixXd::Zero(4, 4), o), input_error);
   EXPECT_THROW(imaginary_axis_crossings(t.a0, Eigen::MatrixXd::Identity(50, 50), o), input_error);
+}
+
+TEST(axis_crossings, b_reaching_into_the_flow_columns) {
+  const toy t = make_toy(true);
+  check_toy(t, "toy with B_sf");
+  // the crossings move when B_sf is dropped: the flow columns are really used
+  const toy t0 = make_toy();
+  axis_crossing_options o;
+  o.omega_min = 1e-3;
+  o.omega_max = 6.0;
+  o.samples = 3000;
+  const auto r = imaginary_axis_crossings(t.a0, t.b_ss, t.b_sf, o), r0 = imaginary_axis_crossings(t0.a0, t0.b_ss, o);
+  ASSERT_FALSE(r.crossings.empty());
+  ASSERT_FALSE(r0.crossings.empty());
+  EXPECT_GT(std::abs(r.crossings.front().q - r0.crossings.front().q), 1e-4);
+  // split_affine recovers A0, B_ss and B_sf from two matrices of the family
+  const double q1 = 0.7, q2 = 1.9;
+  const Eigen::SparseMatrix<double> j1 = t.dense(q1).sparseView(), j2 = t.dense(q2).sparseView();
+  const affine_split sp = split_affine(j1, q1, j2, q2, 4, "toy");
+  EXPECT_LT((Eigen::MatrixXd(sp.a0) - t.dense(0)).norm(), 1e-13);
+  EXPECT_LT((sp.b_ss - t.b_ss).norm(), 1e-13);
+  EXPECT_LT((Eigen::MatrixXd(sp.b_sf) - Eigen::MatrixXd(t.b_sf)).norm(), 1e-13);
+  const auto rs = imaginary_axis_crossings(sp, o);
+  ASSERT_EQ(rs.crossings.size(), r.crossings.size());
+  for (std::size_t k = 0; k < r.crossings.size(); ++k) {
+    EXPECT_NEAR(rs.crossings[k].q, r.crossings[k].q, 1e-9 * (1 + std::abs(r.crossings[k].q)));
+    EXPECT_NEAR(rs.crossings[k].omega, r.crossings[k].omega, 1e-9);
+  }
+  // B_sf of the wrong shape or with non-finite entries is refused
+  EXPECT_THROW(imaginary_axis_crossings(t.a0, t.b_ss, Eigen::SparseMatrix<double>(4, 7), o), input_error);
+  Eigen::SparseMatrix<double> bad = t.b_sf;
+  bad.coeffRef(1, 0) = NAN;
+  EXPECT_THROW(imaginary_axis_crossings(t.a0, t.b_ss, bad, o), input_error);
 }
 
 // The aerofoil: q = 1/Ubar^2 enters only the structural stiffness, so J(Ubar) = A0 + q B with B in

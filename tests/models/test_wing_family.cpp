@@ -1,8 +1,8 @@
 // The wing as a flutter_family (models/wing_family.hpp): the speed-of-sound schedule, the flutter
 // numbers against the AGARD 445.6 experiment table of spec 06 (mass ratio and flutter speed
 // index from density and speed), the levels and their transfers on a tiny C-H grid, refusals,
-// and the library's flutter-boundary driver over two Mach numbers, its first point the Hopf
-// point of a direct solve.
+// and the library's flutter-boundary driver over three Mach numbers, its first point the Hopf
+// point of a direct solve, its last the lowest imaginary-axis crossing (axis_crossings.hpp).
 #include <gtest/gtest.h>
 
 #include <aerohopf/bifurcation/flutter_boundary.hpp>
@@ -121,9 +121,17 @@ TEST(wing_family, flutter_boundary_driver_runs_on_the_wing) {
   o.start_mu = 0.075;
   o.start_omega = 0.4;
   o.log = nullptr;
+  o.check_crossings = true;  // affordable on this grid (sparse LUs of the flow block)
   const flutter_boundary b = trace_flutter_boundary(f, 1, {0.5, 0.55, 0.6}, nullptr, o);
   ASSERT_TRUE(b.complete) << b.stop_reason;
   ASSERT_EQ(b.points.size(), 3u);
+  // the last point is the lowest imaginary-axis crossing of A0 + mu B, B with flow columns
+  ASSERT_FALSE(b.checks.empty());
+  for (const auto& c : b.checks) {
+    std::cout << "crossing check M = " << c.mach << " (" << c.what << "): " << c.crossings << " crossings, lowest mu "
+              << c.lowest_mu << " omega " << c.lowest_omega << "\n";
+    EXPECT_TRUE(c.pass) << c.what;
+  }
   for (const auto& p : b.points)
     std::cout << "M = " << p.mach << ": mu* = " << p.mu << ", omega* = " << p.omega << " (" << p.newton_iterations
               << " Newton iterations)\n";

@@ -1,25 +1,30 @@
 #pragma once
 // All crossings of the imaginary axis by eigenvalues of A(q) = A0 + q B over a frequency band,
-// when the parameter enters only a small trailing block: B is zero outside its last m rows and
-// columns (the aerofoil: q = 1/Ubar^2 enters only the structural stiffness, spec 05). It needs
-// sparse LU solves with the large block and no eigen-decomposition of A, so it checks on grids
-// where a dense spectrum is out of reach that a Hopf point found by Newton or continuation is the
+// when the parameter enters only a small trailing set of rows: B is zero outside its last m rows
+// (the aerofoil: q = 1/Ubar^2 enters only the structural stiffness, B confined to the trailing
+// m x m block, spec 05; the wing: q = mu = rho c^3 multiplies the generalised forces, whose rows
+// are structural but whose columns include the wall cells' flow unknowns). It needs sparse LU
+// solves with the large block and no eigen-decomposition of A, so it checks on grids where a
+// dense spectrum is out of reach that a Hopf point found by Newton or continuation is the
 // LOWEST crossing (the flutter boundary) and not a later one.
 //
-// Split the unknowns into f (first n - m) and s (last m). With X(w) = i w I - A_ff,
-//     det(i w I - A(q)) = det X(w) det(E(w) - q B_ss),
-//     E(w) = i w I - A_ss - A_sf X(w)^{-1} A_fs         (the m x m Schur complement),
-// so, where X(w) is regular, i w is an eigenvalue of A(q) iff det(E(w) - q B_ss) = 0: q is the
-// reciprocal of a nonzero eigenvalue of E(w)^{-1} B_ss (rank B_ss = r such roots q_k(w)). A
-// crossing at a REAL q is a zero of Im q_k(w) along a root branch. The band [omega_min,
-// omega_max] is sampled (one complex sparse LU of X(w) per sample: A_ff does not depend on q),
-// the r roots are matched from sample to sample (nearest permutation), and every sign change of
-// Im q_k is refined by the Illinois (modified regula falsi) iteration on w until the bracket is
-// shorter than omega_tolerance. A sign change through a pole (|q| -> infinity) is not a
-// crossing: a refined root must have |Im q| <= real_tolerance (1 + |q|), else it is dropped and
-// counted in `rejected`. Not covered: w = 0 (static divergence: real q with det(E(0) - q B_ss)
-// = 0, see `divergence_roots`) and crossings whose frequency lies outside the band or between
-// two samples twice (two crossings of one branch closer than the sample spacing).
+// Split the unknowns into f (first n - m) and s (last m), B = [0 0; B_sf B_ss]. With
+// X(w) = i w I - A_ff and Y(w) = X(w)^{-1} A_fs,
+//     det(i w I - A(q)) = det X(w) det(E(w) - q H(w)),
+//     E(w) = i w I - A_ss - A_sf Y(w),   H(w) = B_ss + B_sf Y(w)      (m x m),
+// so, where X(w) is regular, i w is an eigenvalue of A(q) iff det(E(w) - q H(w)) = 0: q is the
+// reciprocal of a nonzero eigenvalue of E(w)^{-1} H(w) (rank [B_sf B_ss] = r such roots q_k(w),
+// as [Y; I] has full column rank). A crossing at a REAL q is a zero of Im q_k(w) along a root
+// branch. The band [omega_min, omega_max] is sampled (one complex sparse LU of X(w) per sample:
+// A_ff does not depend on q), the r roots are matched from sample to sample (nearest
+// permutation), and every sign change of Im q_k is refined by the Illinois (modified regula
+// falsi) iteration on w until the bracket is shorter than omega_tolerance. A sign change through
+// a pole (|q| -> infinity) is not a crossing: a refined root must have |Im q| <= real_tolerance
+// (1 + |q|), else it is dropped and counted in `rejected`. Not covered: w = 0 (static
+// divergence: real q with det(E(0) - q H(0)) = 0, see `divergence_roots`) and crossings whose
+// frequency lies outside the band or between two samples twice (two crossings of one branch
+// closer than the sample spacing). Cost: one sparse LU of the flow block per sample, so in 3D
+// it is for small grids (the 3D fill of a direct factorisation).
 #include <Eigen/Dense>
 #include <Eigen/Sparse>
 
@@ -66,12 +71,15 @@ namespace internal {
 class axis_crossing_roots {
  public:
   using cplx = std::complex<double>;
-  axis_crossing_roots(const Eigen::SparseMatrix<double>& a0, const Eigen::MatrixXd& b_ss, const std::string& context)
+  axis_crossing_roots(const Eigen::SparseMatrix<double>& a0, const Eigen::MatrixXd& b_ss,
+                      const Eigen::SparseMatrix<double>& b_sf, const std::string& context)
       : m_(b_ss.rows()), nf_(a0.rows() - b_ss.rows()), b_(b_ss), lu_(context + ": sparse LU of i omega I - A_ff") {
     require(a0.rows() == a0.cols(), context, ": A0 is ", a0.rows(), "x", a0.cols(), ", not square");
     require(b_ss.rows() == b_ss.cols() && m_ >= 1 && nf_ >= 1, context, ": B_ss is ", b_ss.rows(), "x", b_ss.cols(),
             " for A0 of size ", a0.rows());
     require(b_ss.allFinite(), context, ": B_ss has non-finite entries");
+    require(b_sf.size() == 0 || (b_sf.rows() == m_ && b_sf.cols() == nf_), context, ": B_sf is ", b_sf.rows(), "x",
+            b_sf.cols(), ", not ", m_, "x", nf_, " (structural rows by flow columns)");
     std::vector<Eigen::Triplet<double>> tf;
     a_fs_ = Eigen::MatrixXd::Zero(nf_, m_);
     a_sf_ = Eigen::MatrixXd::Zero(m_, nf_);
@@ -110,13 +118,29 @@ class axis_crossing_roots {
     a_sf_c_ = a_sf_.cast<cplx>();
     a_ss_c_ = a_ss_.cast<cplx>();
     b_c_ = b_.cast<cplx>();
-    // rank of B_ss: its number of nonzero singular values (relative 1e-12)
-    const Eigen::JacobiSVD<Eigen::MatrixXd> svd(b_ss);
+    // rank of [B_sf B_ss]: its number of nonzero singular values (relative 1e-12), the SVD
+    // taken over the columns where B_sf has entries (the wall cells' unknowns for a wing)
+    std::vector<Eigen::Index> cols;
+    if (b_sf.size() != 0) {
+      b_sf_c_ = b_sf.cast<cplx>();
+      b_sf_c_.makeCompressed();
+      for (int k = 0; k < b_sf.outerSize(); ++k)
+        for (Eigen::SparseMatrix<double>::InnerIterator it(b_sf, k); it; ++it) {
+          require(std::isfinite(it.value()), context, ": B_sf(", it.row(), ", ", it.col(), ") is not finite");
+          if (it.value() != 0) cols.push_back(it.col());
+        }
+      std::sort(cols.begin(), cols.end());
+      cols.erase(std::unique(cols.begin(), cols.end()), cols.end());
+    }
+    Eigen::MatrixXd rows(m_, m_ + static_cast<Eigen::Index>(cols.size()));
+    rows.leftCols(m_) = b_ss;
+    for (std::size_t c = 0; c < cols.size(); ++c) rows.col(m_ + static_cast<Eigen::Index>(c)) = b_sf.col(cols[c]);
+    const Eigen::BDCSVD<Eigen::MatrixXd> svd(rows);
     const auto& sv = svd.singularValues();
     rank_ = 0;
     for (Eigen::Index i = 0; i < sv.size(); ++i)
       if (sv[i] > 1e-12 * sv[0]) ++rank_;
-    require(rank_ >= 1, context, ": B_ss is zero: the parameter does not enter A");
+    require(rank_ >= 1, context, ": B is zero: the parameter does not enter A");
   }
   int rank() const { return rank_; }
   int factorisations() const { return factorisations_; }
@@ -130,7 +154,9 @@ class axis_crossing_roots {
     Eigen::MatrixXcd e = -a_ss_c_ - a_sf_c_ * y;
     e.diagonal().array() += cplx(0.0, w);
     const Eigen::PartialPivLU<Eigen::MatrixXcd> elu(e);
-    const Eigen::MatrixXcd mb = elu.solve(b_c_);
+    Eigen::MatrixXcd h = b_c_;  // H(w) = B_ss + B_sf Y(w)
+    if (b_sf_c_.size() != 0) h += b_sf_c_ * y;
+    const Eigen::MatrixXcd mb = elu.solve(h);
     const Eigen::ComplexEigenSolver<Eigen::MatrixXcd> es(mb, false);
     std::vector<cplx> nu(es.eigenvalues().data(), es.eigenvalues().data() + m_);
     std::sort(nu.begin(), nu.end(), [](cplx a, cplx b) { return std::abs(a) > std::abs(b); });
@@ -143,6 +169,7 @@ class axis_crossing_roots {
   Eigen::Index m_, nf_;
   Eigen::MatrixXd b_, a_fs_, a_sf_, a_ss_;
   Eigen::MatrixXcd a_fs_c_, a_sf_c_, a_ss_c_, b_c_;  // complex copies, made once
+  Eigen::SparseMatrix<cplx> b_sf_c_;                // B_sf (empty: B confined to the m x m block)
   Eigen::SparseMatrix<cplx> x_;                     // i w I - A_ff at the last w
   std::vector<Eigen::Index> diag_;                  // positions of its diagonal in valuePtr()
   std::vector<cplx> diag0_;                         // and their values at w = 0
@@ -186,12 +213,13 @@ inline std::vector<std::complex<double>> match_roots(const std::vector<std::comp
 }
 }  // namespace internal
 
-/// A(q) = A0 + q B from the matrices j1 = A(q1) and j2 = A(q2), q1 != q2, of a matrix affine in q
-/// (the aerofoil: q = 1/Ubar^2); throws input_error if j1 - j2 has an entry outside the trailing
-/// m x m block. Affinity itself is the caller's to know (or to check with a third matrix).
+/// A(q) = A0 + q B from the matrices j1 = A(q1) and j2 = A(q2), q1 != q2, of a matrix affine in q;
+/// throws input_error if j1 - j2 has an entry outside the trailing m rows. Affinity itself is the
+/// caller's to know (or to check with a third matrix).
 struct affine_split {
-  Eigen::SparseMatrix<double> a0;  ///< A(0)
-  Eigen::MatrixXd b_ss;            ///< the trailing m x m block of dA/dq
+  Eigen::SparseMatrix<double> a0;    ///< A(0)
+  Eigen::MatrixXd b_ss;              ///< the trailing m x m block of dA/dq
+  Eigen::SparseMatrix<double> b_sf;  ///< the trailing rows' flow columns of dA/dq (m x (n - m); often zero)
 };
 inline affine_split split_affine(const Eigen::SparseMatrix<double>& j1, double q1, const Eigen::SparseMatrix<double>& j2,
                                  double q2, Eigen::Index m, const std::string& context = "split_affine") {
@@ -201,32 +229,44 @@ inline affine_split split_affine(const Eigen::SparseMatrix<double>& j1, double q
   const Eigen::Index n = j1.rows();
   require(m >= 1 && m < n, context, ": trailing block size ", m, " for matrices of size ", n);
   // Non-finite entries are refused here: NaN - NaN is not zero, so they would otherwise be
-  // reported as a dependence on q outside the trailing block.
+  // reported as a dependence on q outside the trailing rows.
   for (const auto* j : {&j1, &j2})
     for (int k = 0; k < j->outerSize(); ++k)
       for (Eigen::SparseMatrix<double>::InnerIterator it(*j, k); it; ++it)
         require(std::isfinite(it.value()), context, ": ", j == &j1 ? "j1" : "j2", "(", it.row(), ", ", it.col(),
                 ") is not finite (", it.value(), ")");
   const Eigen::SparseMatrix<double> d = j1 - j2;
+  const Eigen::Index nf = n - m;
   affine_split out;
   out.b_ss = Eigen::MatrixXd::Zero(m, m);
+  std::vector<Eigen::Triplet<double>> b_all, b_sf;
   for (int k = 0; k < d.outerSize(); ++k)
     for (Eigen::SparseMatrix<double>::InnerIterator it(d, k); it; ++it) {
       if (it.value() == 0) continue;
-      require(it.row() >= n - m && it.col() >= n - m, context, ": the matrix depends on q at (", it.row(), ", ",
-              it.col(), "), outside the trailing ", m, " x ", m, " block");
-      out.b_ss(it.row() - (n - m), it.col() - (n - m)) = it.value() / (q1 - q2);
+      require(it.row() >= nf, context, ": the matrix depends on q at (", it.row(), ", ", it.col(),
+              "), outside the trailing ", m, " rows");
+      const double b = it.value() / (q1 - q2);
+      b_all.emplace_back(int(it.row()), int(it.col()), b);
+      if (it.col() >= nf)
+        out.b_ss(it.row() - nf, it.col() - nf) = b;
+      else
+        b_sf.emplace_back(int(it.row() - nf), int(it.col()), b);
     }
-  out.a0 = j1;
-  for (Eigen::Index i = 0; i < m; ++i)
-    for (Eigen::Index j = 0; j < m; ++j)
-      if (out.b_ss(i, j) != 0) out.a0.coeffRef(n - m + i, n - m + j) -= q1 * out.b_ss(i, j);
+  Eigen::SparseMatrix<double> bm(n, n);
+  bm.setFromTriplets(b_all.begin(), b_all.end());
+  out.a0 = j1 - q1 * bm;
+  out.a0.makeCompressed();
+  out.b_sf.resize(m, nf);
+  out.b_sf.setFromTriplets(b_sf.begin(), b_sf.end());
+  out.b_sf.makeCompressed();
   return out;
 }
 
-/// All crossings of the imaginary axis by eigenvalues of A0 + q B (B nonzero only in its trailing
-/// block b_ss) with frequency in [omega_min, omega_max] (file comment).
+/// All crossings of the imaginary axis by eigenvalues of A0 + q B, B = [0 0; B_sf B_ss] nonzero
+/// only in its trailing m rows (b_sf empty: B confined to the trailing block b_ss), with
+/// frequency in [omega_min, omega_max] (file comment).
 inline axis_crossing_result imaginary_axis_crossings(const Eigen::SparseMatrix<double>& a0, const Eigen::MatrixXd& b_ss,
+                                                     const Eigen::SparseMatrix<double>& b_sf,
                                                      const axis_crossing_options& opt = {}) {
   const std::string& ctx = opt.context;
   require(std::isfinite(opt.omega_max) && opt.omega_min > 0 && opt.omega_max > opt.omega_min && opt.samples >= 2, ctx,
@@ -236,7 +276,7 @@ inline axis_crossing_result imaginary_axis_crossings(const Eigen::SparseMatrix<d
               opt.real_tolerance > 0 && opt.max_refinements >= 1,
           ctx, ": tolerances must be finite and > 0 and max_refinements >= 1 (got omega_tolerance ",
           opt.omega_tolerance, ", real_tolerance ", opt.real_tolerance, ", max_refinements ", opt.max_refinements, ")");
-  internal::axis_crossing_roots roots(a0, b_ss, ctx);
+  internal::axis_crossing_roots roots(a0, b_ss, b_sf, ctx);
   axis_crossing_result res;
   res.rank = roots.rank();
   res.divergence_roots = roots.at(0.0);
@@ -294,6 +334,17 @@ inline axis_crossing_result imaginary_axis_crossings(const Eigen::SparseMatrix<d
   std::sort(res.crossings.begin(), res.crossings.end(), [](const auto& u, const auto& v) { return u.q > v.q; });
   res.factorisations = roots.factorisations();
   return res;
+}
+
+/// B confined to the trailing m x m block b_ss (the aerofoil).
+inline axis_crossing_result imaginary_axis_crossings(const Eigen::SparseMatrix<double>& a0, const Eigen::MatrixXd& b_ss,
+                                                     const axis_crossing_options& opt = {}) {
+  return imaginary_axis_crossings(a0, b_ss, Eigen::SparseMatrix<double>(), opt);
+}
+
+/// The split of split_affine.
+inline axis_crossing_result imaginary_axis_crossings(const affine_split& sp, const axis_crossing_options& opt = {}) {
+  return imaginary_axis_crossings(sp.a0, sp.b_ss, sp.b_sf, opt);
 }
 
 }  // namespace aerohopf

@@ -32,9 +32,9 @@
 // work beyond one steady solve per point. flutter_boundary_costs is a pure function of them.
 //
 // Check: every jump, the first point past a skipped Mach number and the last point are tested
-// by imaginary_axis_crossings (the parameter enters the structural block as q(mu) B, the
+// by imaginary_axis_crossings (the parameter enters the structural rows as q(mu) B, the
 // family's stiffness_factor): PASS iff the lowest crossing above min_crossing_fraction mu* is
-// the boundary point itself.
+// the boundary point itself. It costs one sparse LU of the flow block per frequency sample.
 //
 // Moving equilibrium (moving_equilibrium: a mean incidence, the static deflection grows with
 // mu): every point is a full Hopf system; where a branch ends, the tracer hand-over (it assumes a
@@ -1319,7 +1319,8 @@ flutter_boundary flutter_boundary_tracer<F>::run() {
 }  // namespace internal
 
 /// The crossing check of one boundary point: every imaginary-axis crossing of A0 + q(mu) B
-/// (axis_crossings.hpp) with omega in [omega_min, factor omega*]; PASS iff the lowest one above
+/// (axis_crossings.hpp) with omega in [omega_min, factor omega*]; PASS iff the lowest one in mu
+/// (the aerofoil's speed, largest q = 1/mu^2; the wing's density, q = mu) above
 /// crossing_min_fraction mu* is the point itself. Needs the equilibrium independent of mu.
 template <flutter_family F>
 crossing_check_record check_flutter_crossing(const F& family, int level, const flutter_boundary_point& p,
@@ -1335,7 +1336,7 @@ crossing_check_record check_flutter_crossing(const F& family, int level, const f
   ao.omega_max = o.crossing_omega_factor * p.omega;
   ao.samples = std::max(100, static_cast<int>(std::ceil((ao.omega_max - ao.omega_min) / 0.02)));
   ao.context = o.label + " crossing check";
-  const axis_crossing_result r = imaginary_axis_crossings(sp.a0, sp.b_ss, ao);
+  const axis_crossing_result r = imaginary_axis_crossings(sp, ao);
   crossing_check_record c;
   c.mach = p.mach;
   c.mu = p.mu;
@@ -1347,7 +1348,7 @@ crossing_check_record check_flutter_crossing(const F& family, int level, const f
     if (!(x.q > 0)) continue;
     const double u = family.parameter_of_factor(x.q);
     c.all.emplace_back(u, x.omega);
-    if (u >= o.crossing_min_fraction * p.mu && (!lowest || x.q > lowest->q)) {
+    if (u >= o.crossing_min_fraction * p.mu && (!lowest || u < c.lowest_mu)) {  // lowest in mu, not in q
       lowest = &x;
       c.lowest_mu = u;
     }

@@ -13,10 +13,11 @@
 // flutter speed index FSI = U / (b_s omega_alpha sqrt(mass ratio)) (flutter_numbers).
 //
 // The parameter enters the coupled Jacobian as mu B with B the derivative of the generalised
-// forces: its rows are the structural ones, its columns include the wall cells' flow unknowns,
-// so the trailing-block crossing check (axis_crossings.hpp, B confined to the structural
-// block) does not apply and boundary_options() switches it off; the example's V-g diagram and
-// the dense-spectrum test of models/wing.hpp are the checks that a point is the lowest crossing.
+// forces: its rows are the structural ones, its columns include the wall cells' flow unknowns
+// (axis_crossings.hpp handles that: H(w) = B_ss + B_sf X^{-1} A_fs). Its crossing check needs a
+// complex sparse LU of the 3D flow Jacobian per frequency sample, so boundary_options() switches
+// it off (turn it on for very coarse grids); on real grids the example's V-g diagram is the check
+// that a point is the lowest crossing.
 #include <algorithm>
 #include <cmath>
 #include <complex>
@@ -186,8 +187,8 @@ class wing_family {
   /// points: flutter_boundary_options::mu_min); the inverse-power start
   /// to 1e-3 (its solves are the dearest part of a first point: 110 s of 131 s on the coarse
   /// grid at 1e-8, measured) with GMRES(80) (GMRES(50) stagnated at a relative residual of 0.98
-  /// on the coarse grid at M = 0.901, GMRES(80) converged); no trailing-block crossing check
-  /// (file comment).
+  /// on the coarse grid at M = 0.901, GMRES(80) converged); no crossing check (its sparse
+  /// LUs: file comment).
   flutter_boundary_options boundary_options() const {
     flutter_boundary_options o;
     o.check_crossings = false;
