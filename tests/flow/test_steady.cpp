@@ -196,6 +196,12 @@ TEST(steady_solver, rejects_bad_options_and_nan_state_naming_them) {
   o = {};
   o.max_steps = -1;
   refused(o, "max_steps");
+  o = {};
+  o.stall_factor = 1.5;
+  refused(o, "stall_factor");
+  o = {};
+  o.fill_level = -1;
+  refused(o, "fill_level");
   vec<double> w = w0;
   w[5] = NAN;
   try {
@@ -205,4 +211,34 @@ TEST(steady_solver, rejects_bad_options_and_nan_state_naming_them) {
     EXPECT_TRUE(has(e.what(), "state entry 5")) << e.what();
   }
   EXPECT_TRUE(std::isnan(w[5]));
+}
+
+// A Newton phase that cannot converge (one GMRES iteration per step) is reported as stalled,
+// naming the cell with the largest residual, instead of running to max_steps; the same case with
+// the default linear solves converges, also with BILU(1) as the preconditioner.
+TEST(steady_solver, stalled_newton_fails_clearly_naming_the_worst_cell) {
+  euler_model<2> m(coarsen(naca_cgrid(), 8), {.mach = 0.5, .alpha_rad = 0.02});
+  steady_options o;
+  o.exact_switch_drop = 1.0;  // Newton from the first step on
+  o.linear_max_iterations = 1;
+  o.restart = 1;
+  o.stall_steps = 3;
+  o.stall_factor = 0.01;
+  vec<double> w = m.free_stream_vector();
+  try {
+    solve_steady<2>(m, w, o);
+    FAIL() << "expected convergence_error";
+  } catch (const convergence_error& e) {
+    EXPECT_TRUE(has(e.what(), "Newton stalled")) << e.what();
+    EXPECT_TRUE(has(e.what(), " cell (")) << e.what();
+    EXPECT_TRUE(has(e.what(), "largest residual")) << e.what();
+  }
+  EXPECT_TRUE(m.is_physical(w));  // the last accepted state
+  for (int fill : {0, 1}) {
+    steady_options d;
+    d.fill_level = fill;
+    vec<double> v = m.free_stream_vector();
+    const steady_report r = solve_steady<2>(m, v, d);
+    EXPECT_TRUE(r.converged) << "BILU(" << fill << "): " << r.reason;
+  }
 }

@@ -140,6 +140,16 @@ class euler_model {
   std::size_t n_cells() const { return offset_.back(); }
   Eigen::Index size() const { return static_cast<Eigen::Index>(n_cells() * nv); }
   std::size_t cell_offset(int block) const { return offset_[block]; }
+  /// "block b cell (i,j[,k])" of state cell `global` (< n_cells()), for messages.
+  std::string cell_name(std::size_t global) const {
+    require(global < n_cells(), "euler_model::cell_name: cell ", global, " of ", n_cells());
+    std::size_t b = 0;
+    while (global >= offset_[b + 1]) ++b;
+    const auto c = unravel<Dim>(global - offset_[b], grid_.topology.cells[b]);
+    std::string s = aerohopf::internal::concat("block ", b, " cell (");
+    for (int e = 0; e < Dim; ++e) s += aerohopf::internal::concat(e ? "," : "", c[e]);
+    return s + ")";
+  }
   const std::vector<halo_cell>& halos() const { return halos_; }
 
   /// Moves the grid: new points and point velocities (the model's block count and shapes; see

@@ -51,7 +51,13 @@ struct steady_options {
   double linear_tolerance = 1e-2;     // relative tolerance of each GMRES solve
   int linear_max_iterations = 200;
   int restart = 60;
+  int fill_level = 0;                 // k of the BILU(k) preconditioner (of the modified-order matrix)
   double exact_switch_drop = 1e-3;   // exact Jacobian once ||R||/||R_0|| < this (0: never)
+  // With the exact Jacobian (Newton), fail as stalled when stall_steps steps in a row have not
+  // brought ||R|| below stall_factor times its value before them (0: never); the message names
+  // the cell with the largest residual.
+  int stall_steps = 10;
+  double stall_factor = 0.5;
   std::ostream* log = nullptr;        // progress line per step when set
   bool throw_on_failure = true;       // false: a failure is returned in the report (reason)
 };
@@ -94,6 +100,9 @@ inline void check_steady_options(const steady_options& o, const char* who) {
   require(o.linear_max_iterations >= 1, who, ": linear_max_iterations must be >= 1 (got ", o.linear_max_iterations,
           ")");
   require(o.restart >= 1, who, ": restart must be >= 1 (got ", o.restart, ")");
+  require(o.stall_steps >= 0 && std::isfinite(o.stall_factor) && o.stall_factor > 0 && o.stall_factor < 1, who,
+          ": need stall_steps >= 0 and stall_factor in (0, 1) (got ", o.stall_steps, ", ", o.stall_factor, ")");
+  require(o.fill_level >= 0 && o.fill_level <= 8, who, ": fill_level must lie in [0, 8] (got ", o.fill_level, ")");
   require(std::isfinite(o.exact_switch_drop) && o.exact_switch_drop >= 0 && o.exact_switch_drop <= 1, who,
           ": exact_switch_drop must lie in [0, 1] (got ", o.exact_switch_drop, ")");
 }
@@ -131,13 +140,17 @@ steady_report solve_steady(euler_model<Dim>& m, vec<double>& w, const steady_opt
   const auto n = static_cast<Eigen::Index>(m.n_cells());
   const double rootn = std::sqrt(static_cast<double>(w.size()));
   block_sparse_matrix<double, nv> a, ax;  // modified-order (preconditioner), exact (operator)
-  block_ilu<double, nv> ilu;
+  block_ilu_options io;
+  io.fill_level = opt.fill_level;
+  io.context = "solve_steady: BILU";
+  block_ilu<double, nv> ilu(io);
   bool analysed = false;
   jacobian_kind kind = jacobian_kind::modified_order;
   steady_report rep;
   const bool vortex = Dim == 2 && m.options().vortex_far_field;
   double res = NAN, cfl = NAN;
   int step = 0;
+  int exact_from = -1;  // history index of the first step with the exact Jacobian
   // "step k (||R|| = .., CFL .., M = .., alpha = .. deg[, circulation ..])": the context of a failure
   auto where = [&]() {
     std::string s = aerohopf::internal::concat("step ", step, " (||R||/sqrt(n) = ", res, " of the last accepted state");
@@ -268,6 +281,31 @@ steady_report solve_steady(euler_model<Dim>& m, vec<double>& w, const steady_opt
       std::snprintf(line, sizeof line, "step %4d  res %.3e  drop %.2e  CFL %.3e  lin %3d  CL %+.6f%s\n", step, res,
                     res / rep.initial_residual, cfl, lin.iterations, cl, kind == jacobian_kind::exact ? "  (exact J)" : "");
       *opt.log << line << std::flush;
+    }
+    if (kind == jacobian_kind::exact) {
+      if (exact_from < 0) exact_from = static_cast<int>(rep.history.size()) - 1;
+      const int h = static_cast<int>(rep.history.size()) - 1;
+      if (opt.stall_steps > 0 && h - exact_from >= opt.stall_steps && !done()) {
+        const double before = rep.history[static_cast<std::size_t>(h - opt.stall_steps)].residual;
+        double best = INFINITY;
+        for (int k = h - opt.stall_steps + 1; k <= h; ++k) best = std::min(best, rep.history[static_cast<std::size_t>(k)].residual);
+        if (!(best < opt.stall_factor * before)) {
+          Eigen::Index worst = 0;
+          double worst_norm = -1;
+          for (Eigen::Index c = 0; c < n; ++c)
+            if (const double v = r.segment(c * nv, nv).norm(); v > worst_norm) {
+              worst_norm = v;
+              worst = c;
+            }
+          std::string cell;
+          if constexpr (requires { m.cell_name(std::size_t{}); }) cell = m.cell_name(static_cast<std::size_t>(worst));
+          else cell = aerohopf::internal::concat("state cell ", worst);
+          return fail(aerohopf::internal::concat(
+              "Newton stalled: ", opt.stall_steps, " steps with the exact Jacobian took ||R|| only from ", before, " to ",
+              best, " (GMRES at ", lin.iterations, " of at most ", opt.linear_max_iterations,
+              " iterations in the last step); largest residual ", worst_norm, " in ", cell, ", at ", where()));
+        }
+      }
     }
   }
   step = rep.steps;
