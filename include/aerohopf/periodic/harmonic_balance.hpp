@@ -1,0 +1,608 @@
+#pragma once
+// Limit cycles of dw/dt = f(w, mu) by harmonic balance (time-spectral collocation), continued in
+// amplitude from a Hopf point, and their stability by Hill's method.
+//
+// Unknowns: the states w_j = w(tau_j) at the N = 2 H + 1 phases tau_j = 2 pi j / N of one period
+// (tau = omega t, H harmonics), the angular frequency omega, the parameter mu and the amplitude a.
+// Equations (N n + 2):
+//   G_j = f(w_j, mu) - omega sum_k D_jk w_k = 0                     j = 0 .. N-1
+//   phase:      (2/N) sum_j <e, w_j> sin tau_j = 0
+//   amplitude:  (2/N) sum_j <e, w_j> cos tau_j - a = 0
+// D is the Fourier differentiation matrix of odd N, D_jk = (-1)^(j-k) / (2 sin(pi (j-k) / N))
+// for j != k, D_jj = 0 (exact on trigonometric polynomials of degree <= H), and e the probe, a
+// linear functional of the state (a structural coordinate, an outlet temperature): a is the
+// cosine coefficient of the probe's first harmonic, and its sine coefficient is zero (the phase).
+// One more row closes the system: mu fixed, a fixed, or the curve stepper's row on x = (W,
+// omega, mu, a) with its metric on (mu, a) only, so that the branch passes folds in mu.
+//
+// Newton with the exact Jacobian, assembled sparse and solved by sparse LU (direct_solver):
+//   dG_j/dw_k = delta_jk A(w_j, mu) - omega D_jk I,   dG_j/domega = -(D W)_j,   dG_j/dmu = f_mu(w_j, mu).
+// Converged when ||F||_inf <= tolerance for all N n + 3 rows (the state rows are f's units).
+// Failures (convergence_error): no convergence in max_iterations, a non-finite residual, omega
+// leaving (0, inf); the message names the iteration, ||F||_inf, H, omega, mu and a. The input
+// (the guess, the probe) is checked and never modified.
+//
+// Stability (hill_floquet): the eigenvalues of Hill's matrix in the time domain, blockdiag(A(w_j))
+// - omega D (x) I, are the Floquet exponents sigma + i k omega (k = -H .. H) of the cycle. For
+// each eigenvector the energy-weighted mean index kbar of its discrete Fourier coefficients over
+// k = -H .. H is formed, and the n eigenvalues with the smallest |kbar| are taken: the
+// eigenvector of sigma itself is centred on harmonic 0, its shifted copies on k (the symmetry
+// criterion of Lazarus & Thomas, C. R. Mecanique 338, 2010). The trivial exponent (the phase
+// shift, exactly 0 for the continuous problem: its distance from 0 measures the truncation) is
+// the one nearest 0, and the cycle is stable when every other exponent has Re < 0. Dense: for
+// N n up to hill_max_size.
+#include <Eigen/Core>
+#include <Eigen/Eigenvalues>
+#include <Eigen/SparseCore>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <complex>
+#include <limits>
+#include <numbers>
+#include <optional>
+#include <ostream>
+#include <string>
+#include <vector>
+
+#include "../bifurcation/curve_stepper.hpp"
+#include "../bifurcation/hopf_point.hpp"
+#include "../error.hpp"
+#include "../linalg/direct.hpp"
+#include "../nonlinear/system.hpp"
+
+namespace aerohopf {
+
+/// Fourier differentiation matrix of N (odd) equally spaced phases on [0, 2 pi).
+inline Eigen::MatrixXd fourier_differentiation_matrix(int n) {
+  require(n >= 1 && n % 2 == 1, "fourier_differentiation_matrix: the number of phases must be odd and >= 1 (got ", n,
+          ")");
+  Eigen::MatrixXd d = Eigen::MatrixXd::Zero(n, n);
+  for (int j = 0; j < n; ++j)
+    for (int k = 0; k < n; ++k)
+      if (j != k) {
+        const int m = j - k;
+        d(j, k) = ((m % 2 == 0) ? 0.5 : -0.5) / std::sin(std::numbers::pi * m / n);
+      }
+  return d;
+}
+
+/// A periodic orbit in harmonic-balance form.
+struct lco_solution {
+  int harmonics = 0;           ///< H (N = 2 H + 1 instances)
+  Eigen::MatrixXd instances;   ///< n x N: column j is w(tau_j), tau_j = 2 pi j / N
+  double omega = 0;            ///< angular frequency
+  double mu = 0;               ///< parameter
+  double amplitude = 0;        ///< first-harmonic cosine coefficient of the probe
+  int newton_iterations = 0;
+  double residual = 0;         ///< ||F||_inf at the solution
+  double seconds = 0;          ///< wall time of the solve
+
+  int instance_count() const { return 2 * harmonics + 1; }
+  Eigen::Index state_size() const { return instances.rows(); }
+  double period() const { return 2 * std::numbers::pi / omega; }
+  /// Complex Fourier coefficients c_k, k = 0 .. H (n x (H + 1)): w(tau) = c_0 + 2 Re sum c_k e^{i k tau}.
+  Eigen::MatrixXcd fourier() const {
+    const int nn = instance_count();
+    Eigen::MatrixXcd c = Eigen::MatrixXcd::Zero(instances.rows(), harmonics + 1);
+    for (int k = 0; k <= harmonics; ++k)
+      for (int j = 0; j < nn; ++j)
+        c.col(k) += instances.col(j).cast<std::complex<double>>() *
+                    std::polar(1.0 / nn, -2 * std::numbers::pi * k * j / nn);
+    return c;
+  }
+  /// The trigonometric interpolant at phase tau.
+  vec<double> state(double tau) const {
+    const Eigen::MatrixXcd c = fourier();
+    vec<double> w = c.col(0).real();
+    for (int k = 1; k <= harmonics; ++k) w += 2 * (c.col(k) * std::polar(1.0, k * tau)).real();
+    return w;
+  }
+  /// The mean state (harmonic 0).
+  vec<double> mean() const { return instances.rowwise().mean(); }
+};
+
+/// Half the peak-to-peak excursion of <probe, w(tau)> over the cycle (the trigonometric
+/// interpolant's maximum and minimum, each refined by Newton on its derivative): the amplitude a
+/// time-marching run measures from its signal's peaks.
+inline double probe_peak_amplitude(const lco_solution& s, const vec<double>& probe) {
+  require_size(probe.size(), s.state_size(), "probe_peak_amplitude", "probe");
+  const Eigen::MatrixXcd c = s.fourier();
+  const Eigen::VectorXcd pc = c.transpose() * probe.cast<std::complex<double>>();  // probe's coefficients
+  auto value = [&](double t, int deriv) {
+    double v = deriv == 0 ? pc[0].real() : 0.0;
+    for (int k = 1; k <= s.harmonics; ++k) {
+      const std::complex<double> ik = std::pow(std::complex<double>(0, k), deriv);
+      v += 2 * (pc[k] * ik * std::polar(1.0, k * t)).real();
+    }
+    return v;
+  };
+  const int samples = 64 * s.instance_count();
+  double tmax = 0, tmin = 0, vmax = -INFINITY, vmin = INFINITY;
+  for (int m = 0; m < samples; ++m) {
+    const double t = 2 * std::numbers::pi * m / samples, v = value(t, 0);
+    if (v > vmax) vmax = v, tmax = t;
+    if (v < vmin) vmin = v, tmin = t;
+  }
+  auto refine = [&](double t) {
+    const double h = 2 * std::numbers::pi / samples;
+    const double lo = t - h, hi = t + h;
+    for (int it = 0; it < 20; ++it) {
+      const double d2 = value(t, 2);
+      if (d2 == 0) break;
+      const double tn = std::clamp(t - value(t, 1) / d2, lo, hi);
+      if (std::abs(tn - t) < 1e-15) break;
+      t = tn;
+    }
+    return value(t, 0);
+  };
+  return 0.5 * (std::max(vmax, refine(tmax)) - std::min(vmin, refine(tmin)));
+}
+
+/// The first guess of a cycle of amplitude a near a Hopf point: w_j = w* + Re(eps p e^{i tau_j})
+/// with eps = a / <e, p> (so <e, w(tau)> = <e, w*> + a cos tau), omega*, and mu (mu* unless the
+/// centre-manifold model gives a better value).
+inline lco_solution lco_guess_from_hopf(const hopf_point& hp, const vec<double>& probe, double a, int harmonics,
+                                        std::optional<double> mu = std::nullopt) {
+  const char* who = "lco_guess_from_hopf";
+  require(harmonics >= 1, who, ": harmonics must be >= 1 (got ", harmonics, ")");
+  require_size(probe.size(), hp.w.size(), who, "probe");
+  require_size(hp.p.size(), hp.w.size(), who, "eigenvector p");
+  require_finite(probe, who, "probe");
+  require(std::isfinite(a) && a > 0, who, ": amplitude must be finite and > 0 (got ", a, ")");
+  require(std::isfinite(hp.omega) && hp.omega > 0, who, ": the Hopf frequency must be > 0 (got ", hp.omega, ")");
+  const std::complex<double> ep = probe.cast<std::complex<double>>().dot(hp.p);  // conj(probe) . p = probe . p
+  require(std::abs(ep) > 1e-12 * probe.norm() * hp.p.norm(), who,
+          ": the probe does not see the critical eigenvector (<e, p> = ", std::abs(ep), ")");
+  const std::complex<double> eps = a / ep;
+  lco_solution s;
+  s.harmonics = harmonics;
+  const int nn = 2 * harmonics + 1;
+  s.instances.resize(hp.w.size(), nn);
+  for (int j = 0; j < nn; ++j)
+    s.instances.col(j) = hp.w + (eps * hp.p * std::polar(1.0, 2 * std::numbers::pi * j / nn)).real();
+  s.omega = hp.omega;
+  s.mu = mu.value_or(hp.mu);
+  s.amplitude = a;
+  return s;
+}
+
+/// The same cycle on H' harmonics (trigonometric interpolation; truncation when H' < H).
+inline lco_solution resample(const lco_solution& s, int harmonics) {
+  require(harmonics >= 1, "resample: harmonics must be >= 1 (got ", harmonics, ")");
+  lco_solution r = s;
+  r.harmonics = harmonics;
+  const int nn = 2 * harmonics + 1;
+  const Eigen::MatrixXcd c = s.fourier();
+  r.instances.resize(s.state_size(), nn);
+  for (int j = 0; j < nn; ++j) {
+    const double tau = 2 * std::numbers::pi * j / nn;
+    vec<double> w = c.col(0).real();
+    for (int k = 1; k <= std::min(harmonics, s.harmonics); ++k) w += 2 * (c.col(k) * std::polar(1.0, k * tau)).real();
+    r.instances.col(j) = w;
+  }
+  r.newton_iterations = 0;
+  r.residual = NAN;
+  return r;
+}
+
+struct harmonic_balance_options {
+  double tolerance = 1e-10;  ///< on ||F||_inf
+  int max_iterations = 25;
+  std::ostream* log = nullptr;  ///< one line per Newton iteration when set
+  std::string label = "harmonic balance";
+};
+
+/// What closes the harmonic-balance system in solve_lco.
+enum class lco_fix { amplitude, parameter };
+
+namespace internal {
+
+/// The harmonic-balance equations of one system, probe and number of harmonics, on x = (w_0 ..
+/// w_{N-1}, omega, mu, a).
+template <dynamical_system S>
+class harmonic_balance_equations {
+ public:
+  harmonic_balance_equations(const S& sys, const vec<double>& probe, int harmonics)
+      : sys_(sys), probe_(probe), h_(harmonics), nn_(2 * harmonics + 1), n_(sys.size()),
+        d_(fourier_differentiation_matrix(2 * harmonics + 1)) {
+    for (int j = 0; j < nn_; ++j) {
+      const double tau = 2 * std::numbers::pi * j / nn_;
+      sin_.push_back(2.0 / nn_ * std::sin(tau));
+      cos_.push_back(2.0 / nn_ * std::cos(tau));
+    }
+  }
+  Eigen::Index n() const { return n_; }
+  int instances() const { return nn_; }
+  Eigen::Index unknowns() const { return nn_ * n_ + 3; }
+  Eigen::Index omega_index() const { return nn_ * n_; }
+  Eigen::Index mu_index() const { return nn_ * n_ + 1; }
+  Eigen::Index amplitude_index() const { return nn_ * n_ + 2; }
+
+  vec<double> pack(const lco_solution& s) const {
+    vec<double> x(unknowns());
+    for (int j = 0; j < nn_; ++j) x.segment(j * n_, n_) = s.instances.col(j);
+    x[omega_index()] = s.omega;
+    x[mu_index()] = s.mu;
+    x[amplitude_index()] = s.amplitude;
+    return x;
+  }
+  lco_solution unpack(const vec<double>& x) const {
+    lco_solution s;
+    s.harmonics = h_;
+    s.instances.resize(n_, nn_);
+    for (int j = 0; j < nn_; ++j) s.instances.col(j) = x.segment(j * n_, n_);
+    s.omega = x[omega_index()];
+    s.mu = x[mu_index()];
+    s.amplitude = x[amplitude_index()];
+    return s;
+  }
+
+  /// F(x) without the closing row (N n + 2 entries).
+  vec<double> residual(const vec<double>& x) const {
+    const double omega = x[omega_index()], mu = x[mu_index()];
+    vec<double> f(nn_ * n_ + 2);
+    const Eigen::Map<const Eigen::MatrixXd> w(x.data(), n_, nn_);
+    const Eigen::MatrixXd dw = w * d_.transpose();  // column j = sum_k D_jk w_k
+    double ps = 0, pc = 0;
+    for (int j = 0; j < nn_; ++j) {
+      const vec<double> wj = w.col(j);
+      f.segment(j * n_, n_) = sys_.residual(wj, mu) - omega * dw.col(j);
+      const double e = probe_.dot(wj);
+      ps += sin_[j] * e;
+      pc += cos_[j] * e;
+    }
+    f[nn_ * n_] = ps;
+    f[nn_ * n_ + 1] = pc - x[amplitude_index()];
+    return f;
+  }
+
+  /// The exact Jacobian of (F, c.x) (square, N n + 3).
+  Eigen::SparseMatrix<double> jacobian(const vec<double>& x, const vec<double>& c) const {
+    const double omega = x[omega_index()], mu = x[mu_index()];
+    const Eigen::Map<const Eigen::MatrixXd> w(x.data(), n_, nn_);
+    const Eigen::MatrixXd dw = w * d_.transpose();
+    std::vector<Eigen::Triplet<double>> t;
+    const Eigen::Index ow = omega_index(), om = mu_index(), oa = amplitude_index();
+    const Eigen::Index rp = nn_ * n_, ra = rp + 1, rc = rp + 2;
+    for (int j = 0; j < nn_; ++j) {
+      const vec<double> wj = w.col(j);
+      add_block(t, sys_.jacobian(wj, mu), j * n_, j * n_);
+      for (int k = 0; k < nn_; ++k)
+        if (k != j)
+          for (Eigen::Index i = 0; i < n_; ++i) t.emplace_back(j * n_ + i, k * n_ + i, -omega * d_(j, k));
+      const vec<double> fmu = residual_d_mu(sys_, wj, mu);
+      for (Eigen::Index i = 0; i < n_; ++i) {
+        if (dw(i, j) != 0) t.emplace_back(j * n_ + i, ow, -dw(i, j));
+        if (fmu[i] != 0) t.emplace_back(j * n_ + i, om, fmu[i]);
+        if (probe_[i] != 0) {
+          t.emplace_back(rp, j * n_ + i, sin_[j] * probe_[i]);
+          t.emplace_back(ra, j * n_ + i, cos_[j] * probe_[i]);
+        }
+      }
+    }
+    t.emplace_back(ra, oa, -1.0);
+    for (Eigen::Index i = 0; i < c.size(); ++i)
+      if (c[i] != 0) t.emplace_back(rc, i, c[i]);
+    Eigen::SparseMatrix<double> j(unknowns(), unknowns());
+    j.setFromTriplets(t.begin(), t.end());
+    return j;
+  }
+
+  /// Hill's matrix blockdiag(A(w_j)) - omega D (x) I (dense).
+  Eigen::MatrixXd hill_matrix(const lco_solution& s) const {
+    Eigen::MatrixXd m = Eigen::MatrixXd::Zero(nn_ * n_, nn_ * n_);
+    for (int j = 0; j < nn_; ++j) {
+      const vec<double> wj = s.instances.col(j);
+      m.block(j * n_, j * n_, n_, n_) = Eigen::MatrixXd(sys_.jacobian(wj, s.mu));
+      for (int k = 0; k < nn_; ++k)
+        if (k != j) m.block(j * n_, k * n_, n_, n_).diagonal().array() -= s.omega * d_(j, k);
+    }
+    return m;
+  }
+
+ private:
+  template <class M>
+  static void add_block(std::vector<Eigen::Triplet<double>>& t, const M& a, Eigen::Index r0, Eigen::Index c0) {
+    if constexpr (is_sparse_matrix_v<M>) {
+      for (Eigen::Index k = 0; k < a.outerSize(); ++k)
+        for (typename M::InnerIterator it(a, k); it; ++it) t.emplace_back(r0 + it.row(), c0 + it.col(), it.value());
+    } else {
+      for (Eigen::Index q = 0; q < a.cols(); ++q)
+        for (Eigen::Index p = 0; p < a.rows(); ++p)
+          if (a(p, q) != 0) t.emplace_back(r0 + p, c0 + q, a(p, q));
+    }
+  }
+
+  const S& sys_;
+  vec<double> probe_;
+  int h_, nn_;
+  Eigen::Index n_;
+  Eigen::MatrixXd d_;
+  std::vector<double> sin_, cos_;
+};
+
+struct hb_newton_outcome {
+  vec<double> x;
+  int iterations = 0;
+  double residual = 0;
+};
+
+/// Newton on (F(x), c.x - value) = 0 from x0; throws convergence_error on failure.
+template <dynamical_system S>
+hb_newton_outcome hb_newton(const harmonic_balance_equations<S>& eq, vec<double> x, const vec<double>& c,
+                            double value, const harmonic_balance_options& o, const char* who) {
+  direct_solver<Eigen::SparseMatrix<double>> lu(o.label + ": sparse LU of the harmonic-balance Jacobian");
+  const auto describe = [&](int it, double fn) {
+    return concat(who, " (", o.label, "): Newton iteration ", it, ": ||F||_inf = ", fn, " (H = ", (eq.instances() - 1) / 2,
+                  ", omega = ", x[eq.omega_index()], ", mu = ", x[eq.mu_index()], ", a = ", x[eq.amplitude_index()],
+                  ")");
+  };
+  for (int it = 0;; ++it) {
+    vec<double> f(eq.unknowns());
+    f.head(eq.unknowns() - 1) = eq.residual(x);
+    f[eq.unknowns() - 1] = c.dot(x) - value;
+    const double fn = f.cwiseAbs().maxCoeff();
+    if (o.log) *o.log << o.label << ": iteration " << it << "  ||F||_inf " << fn << "  omega " << x[eq.omega_index()]
+                      << "  mu " << x[eq.mu_index()] << "  a " << x[eq.amplitude_index()] << "\n";
+    if (!std::isfinite(fn)) throw convergence_error(describe(it, fn) + ": the residual is not finite");
+    if (fn <= o.tolerance) return {std::move(x), it, fn};
+    if (it >= o.max_iterations)
+      throw convergence_error(describe(it, fn) + concat(": not converged to ", o.tolerance, " in ", o.max_iterations,
+                                                        " iterations"));
+    lu.compute(eq.jacobian(x, c));
+    x -= lu.solve(f);
+    if (!x.allFinite()) throw convergence_error(describe(it + 1, NAN) + ": the Newton update is not finite");
+    if (!(x[eq.omega_index()] > 0))
+      throw convergence_error(describe(it + 1, fn) + ": the frequency left (0, inf): no cycle near the guess");
+  }
+}
+
+inline void check_hb_options(const harmonic_balance_options& o, const char* who) {
+  require(std::isfinite(o.tolerance) && o.tolerance > 0, who, ": tolerance must be finite and > 0 (got ", o.tolerance,
+          ")");
+  require(o.max_iterations >= 1, who, ": max_iterations must be >= 1 (got ", o.max_iterations, ")");
+}
+
+template <dynamical_system S>
+void check_guess(const S& sys, const lco_solution& g, const vec<double>& probe, const char* who) {
+  require(g.harmonics >= 1, who, ": the guess has ", g.harmonics, " harmonics (>= 1 needed)");
+  require(g.instances.rows() == sys.size() && g.instances.cols() == 2 * g.harmonics + 1, who, ": the guess has ",
+          g.instances.rows(), " x ", g.instances.cols(), " instances, the system needs ", sys.size(), " x ",
+          2 * g.harmonics + 1);
+  require(g.instances.allFinite(), who, ": the guess has non-finite states");
+  require(std::isfinite(g.omega) && g.omega > 0, who, ": the guess's frequency must be finite and > 0 (got ", g.omega,
+          ")");
+  require(std::isfinite(g.mu) && std::isfinite(g.amplitude), who, ": the guess's mu and amplitude must be finite");
+  require_size(probe.size(), sys.size(), who, "probe");
+  require_finite(probe, who, "probe");
+  require(probe.norm() > 0, who, ": the probe is zero");
+}
+}  // namespace internal
+
+/// Solves the harmonic-balance system from a guess with either the amplitude a or the parameter
+/// mu held at `value` (the guess's own value when nullopt). The number of harmonics is the guess's
+/// (resample() changes it). Throws convergence_error when Newton fails.
+template <dynamical_system S>
+lco_solution solve_lco(const S& sys, const lco_solution& guess, const vec<double>& probe, lco_fix fix,
+                       std::optional<double> value = std::nullopt, const harmonic_balance_options& o = {}) {
+  const char* who = "solve_lco";
+  internal::check_hb_options(o, who);
+  internal::check_guess(sys, guess, probe, who);
+  const auto t0 = std::chrono::steady_clock::now();
+  const internal::harmonic_balance_equations<S> eq(sys, probe, guess.harmonics);
+  vec<double> x = eq.pack(guess);
+  vec<double> c = vec<double>::Zero(eq.unknowns());
+  const Eigen::Index j = fix == lco_fix::amplitude ? eq.amplitude_index() : eq.mu_index();
+  c[j] = 1;
+  const double v = value.value_or(x[j]);
+  require(std::isfinite(v), who, ": the fixed value is not finite");
+  x[j] = v;
+  const auto r = internal::hb_newton(eq, x, c, v, o, who);
+  lco_solution s = eq.unpack(r.x);
+  s.newton_iterations = r.iterations;
+  s.residual = r.residual;
+  s.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return s;
+}
+
+/// Floquet exponents of a cycle by Hill's method (file comment).
+struct floquet_result {
+  std::vector<std::complex<double>> exponents;  ///< n exponents, by decreasing real part
+  std::complex<double> trivial;                 ///< the one nearest 0 (the phase shift)
+  double max_real = -INFINITY;                  ///< largest real part without the trivial one
+  bool stable = false;                          ///< max_real < 0
+  double period = 0;
+  /// Floquet multipliers exp(sigma T).
+  std::vector<std::complex<double>> multipliers() const {
+    std::vector<std::complex<double>> m;
+    for (const auto& s : exponents) m.push_back(std::exp(s * period));
+    return m;
+  }
+};
+
+struct hill_options {
+  Eigen::Index max_size = 6000;  ///< largest N n for the dense eigen-decomposition
+};
+
+template <dynamical_system S>
+floquet_result hill_floquet(const S& sys, const lco_solution& s, const hill_options& o = {}) {
+  const char* who = "hill_floquet";
+  internal::check_guess(sys, s, vec<double>::Ones(sys.size()), who);
+  const Eigen::Index n = sys.size();
+  const int nn = s.instance_count(), h = s.harmonics;
+  require(n * nn <= o.max_size, who, ": Hill's matrix would be ", n * nn, " x ", n * nn,
+          " (dense), above hill_options::max_size = ", o.max_size);
+  const internal::harmonic_balance_equations<S> eq(sys, vec<double>::Ones(n), h);
+  Eigen::EigenSolver<Eigen::MatrixXd> es(eq.hill_matrix(s), true);
+  require(es.info() == Eigen::Success, who, ": the eigen-decomposition of Hill's matrix failed");
+  const Eigen::VectorXcd lam = es.eigenvalues();
+  const Eigen::MatrixXcd v = es.eigenvectors();
+  struct cand {
+    std::complex<double> l;
+    double kbar;
+  };
+  std::vector<cand> cs;
+  for (Eigen::Index m = 0; m < lam.size(); ++m) {
+    double e = 0, ke = 0;
+    for (int k = -h; k <= h; ++k) {
+      Eigen::VectorXcd ck = Eigen::VectorXcd::Zero(n);
+      for (int j = 0; j < nn; ++j) ck += v.col(m).segment(j * n, n) * std::polar(1.0, -2 * std::numbers::pi * k * j / nn);
+      const double ek = ck.squaredNorm();
+      e += ek;
+      ke += k * ek;
+    }
+    cs.push_back({lam[m], e > 0 ? ke / e : 0.0});
+  }
+  std::stable_sort(cs.begin(), cs.end(), [](const cand& a, const cand& b) {
+    if (std::abs(a.kbar) != std::abs(b.kbar)) return std::abs(a.kbar) < std::abs(b.kbar);
+    return std::abs(a.l.imag()) < std::abs(b.l.imag());
+  });
+  floquet_result r;
+  r.period = s.period();
+  for (Eigen::Index m = 0; m < n; ++m) r.exponents.push_back(cs[std::size_t(m)].l);
+  std::sort(r.exponents.begin(), r.exponents.end(),
+            [](const auto& a, const auto& b) { return a.real() > b.real(); });
+  std::size_t it = 0;
+  for (std::size_t m = 1; m < r.exponents.size(); ++m)
+    if (std::abs(r.exponents[m]) < std::abs(r.exponents[it])) it = m;
+  r.trivial = r.exponents[it];
+  for (std::size_t m = 0; m < r.exponents.size(); ++m)
+    if (m != it) r.max_real = std::max(r.max_real, r.exponents[m].real());
+  r.stable = r.max_real < 0;
+  return r;
+}
+
+/// One point of an LCO branch.
+struct lco_branch_point {
+  lco_solution cycle;
+  double probe_amplitude = 0;           ///< half peak-to-peak of the probe (probe_peak_amplitude)
+  std::optional<floquet_result> floquet;  ///< when stability is computed
+  bool landed = false;                  ///< on a listed mu target
+  double seconds = 0;                   ///< wall time of the step (corrector and stability)
+};
+
+struct lco_branch_options {
+  harmonic_balance_options newton;
+  double mu_scale = 1, amplitude_scale = 1;  ///< the metric: (dmu / mu_scale)^2 + (da / amplitude_scale)^2
+  double step = 0.05, min_step = 1e-6, max_step = 0.2;  ///< arclength steps in that metric
+  int max_points = 60;                  ///< start included
+  double amplitude_max = INFINITY;      ///< stop beyond this first-harmonic amplitude
+  double mu_min = -INFINITY, mu_max = INFINITY;
+  std::vector<double> mu_targets;       ///< landed on exactly (strictly monotone along the branch)
+  int mu_direction = 0;                 ///< first step: 0 towards larger amplitude, +1 / -1 towards larger / smaller mu
+  bool stability = true;                ///< Hill's method at each point (if N n <= hill.max_size)
+  hill_options hill;
+  std::ostream* log = nullptr;
+};
+
+struct lco_branch {
+  std::vector<lco_branch_point> points;
+  std::string stop_reason;
+};
+
+/// Continues a cycle in (mu, a) by the curve stepper (secant predictor, arclength row in the
+/// metric of the options), from a solved start (solve_lco) towards larger amplitude or the
+/// options' mu_direction. Points are
+/// emitted to `on_point` as they are found (it may return true to stop) and returned.
+template <dynamical_system S, class OnPoint>
+lco_branch trace_lco_branch(const S& sys, const lco_solution& start, const vec<double>& probe,
+                            const lco_branch_options& o, OnPoint&& on_point) {
+  const char* who = "trace_lco_branch";
+  internal::check_hb_options(o.newton, who);
+  internal::check_guess(sys, start, probe, who);
+  require(o.mu_direction >= -1 && o.mu_direction <= 1, who, ": mu_direction must be -1, 0 or +1 (got ", o.mu_direction, ")");
+  require(std::isfinite(o.mu_scale) && o.mu_scale > 0 && std::isfinite(o.amplitude_scale) && o.amplitude_scale > 0, who,
+          ": mu_scale and amplitude_scale must be finite and > 0");
+  const internal::harmonic_balance_equations<S> eq(sys, probe, start.harmonics);
+  const Eigen::Index nx = eq.unknowns(), im = eq.mu_index(), ia = eq.amplitude_index();
+  vec<double> weight = vec<double>::Zero(nx);
+  weight[im] = 1 / (o.mu_scale * o.mu_scale);
+  weight[ia] = 1 / (o.amplitude_scale * o.amplitude_scale);
+  const curve_metric metric(weight);
+  const bool hill = o.stability && sys.size() * start.instance_count() <= o.hill.max_size;
+  lco_branch out;
+  auto record = [&](const vec<double>& x, int iterations, double residual, bool landed, double seconds) {
+    const auto t0 = std::chrono::steady_clock::now();
+    lco_branch_point p;
+    p.cycle = eq.unpack(x);
+    p.cycle.newton_iterations = iterations;
+    p.cycle.residual = residual;
+    p.probe_amplitude = probe_peak_amplitude(p.cycle, probe);
+    if (hill) p.floquet = hill_floquet(sys, p.cycle, o.hill);
+    p.landed = landed;
+    p.seconds = seconds + std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    p.cycle.seconds = p.seconds;
+    if (o.log) {
+      *o.log << who << ": point " << out.points.size() << "  mu " << p.cycle.mu << "  a " << p.cycle.amplitude
+             << "  peak " << p.probe_amplitude << "  omega " << p.cycle.omega << "  Newton " << iterations;
+      if (p.floquet) *o.log << "  max Re(sigma) " << p.floquet->max_real << (p.floquet->stable ? " stable" : " unstable");
+      *o.log << (landed ? "  (landed)" : "") << "\n";
+    }
+    out.points.push_back(std::move(p));
+    return on_point(out.points.back());
+  };
+  struct corrected : curve_corrected {
+    double residual = 0;
+  };
+  double last_residual = start.residual;
+  curve_problem prob{
+      [&](const curve_request& q, std::string& why) -> std::optional<corrected> {
+        try {
+          const auto r = internal::hb_newton(eq, q.x0, q.c, q.value, o.newton, who);
+          corrected c;
+          c.x = r.x;
+          c.iterations = r.iterations;
+          c.residual = r.residual;
+          last_residual = r.residual;
+          return c;
+        } catch (const convergence_error& e) {
+          why = e.what();
+        } catch (const singular_matrix_error& e) {
+          why = e.what();
+        }
+        return std::nullopt;
+      },
+      [&](const vec<double>& x, const vec<double>& c) -> vec<double> {  // [F_x; c^T] t = e_last
+        direct_solver<Eigen::SparseMatrix<double>> lu(internal::concat(who, ": tangent"));
+        lu.compute(eq.jacobian(x, c));
+        return lu.solve(vec<double>::Unit(nx, nx - 1));
+      },
+      [&](const vec<double>& x, const curve_point_info& info) {
+        return record(x, info.start ? start.newton_iterations : info.iterations,
+                      info.start ? start.residual : last_residual, info.landed, info.seconds);
+      }};
+  curve_stepper_options so;
+  so.step = o.step;
+  so.min_step = o.min_step;
+  so.max_step = o.max_step;
+  so.max_points = o.max_points;
+  so.label = who;
+  so.log = o.log;
+  if (!o.mu_targets.empty()) so.targets.push_back({im, o.mu_targets, "mu"});
+  so.limits.push_back({im, o.mu_min, o.mu_max});
+  so.limits.push_back({ia, -INFINITY, o.amplitude_max});
+  // the exact unit tangent at the start, oriented by the options
+  const vec<double> x0 = eq.pack(start);
+  vec<double> c0 = vec<double>::Zero(nx);
+  c0[im] = 1 / o.mu_scale;
+  c0[ia] = 1 / o.amplitude_scale;
+  vec<double> t0 = prob.tangent(x0, c0);
+  require(metric.norm(t0) > 0 && t0.allFinite(), who, ": no tangent at the start (mu and a both stationary)");
+  t0 /= metric.norm(t0);
+  const double orient = o.mu_direction != 0 ? o.mu_direction * t0[im] : t0[ia];
+  if (orient < 0) t0 = -t0;
+  const curve_outcome oc = trace_curve(prob, x0, t0, metric, so);
+  out.stop_reason = oc.reason;
+  return out;
+}
+
+/// trace_lco_branch without a callback.
+template <dynamical_system S>
+lco_branch trace_lco_branch(const S& sys, const lco_solution& start, const vec<double>& probe,
+                            const lco_branch_options& o = {}) {
+  return trace_lco_branch(sys, start, probe, o, [](const lco_branch_point&) { return false; });
+}
+
+}  // namespace aerohopf
