@@ -8,11 +8,15 @@
 //   coefficients.csv       centre-manifold coefficients: FD in double/dd/qd over h, and taylor
 //   damping.csv            damping model below mu* vs the exact critical eigenvalue
 //   reduced_vs_full.csv    LCO amplitude of Theta(x=1): reduced model vs time marching
+//   lco_branch.csv         the LCO branch by harmonic balance (1, 2, 3, 5, 8 harmonics), with
+//                          Floquet stability, for mu* - 2e-3 <= mu <= mu* + 2e-3
+//   lco_compare.csv        harmonic balance, reduced model and time marching at the marched points
 //   history_*.csv          time histories (full and reduced) at mu* + 7e-5 and mu* + 7.5e-4
 // plot.py in this folder turns them into PNGs.
 #include <aerohopf/bifurcation.hpp>
 #include <aerohopf/io/csv.hpp>
 #include <aerohopf/models/tubular_reactor.hpp>
+#include <aerohopf/periodic.hpp>
 #include <aerohopf/reduction.hpp>
 #include <aerohopf/scalar/qd.hpp>
 #include <aerohopf/time.hpp>
@@ -246,6 +250,11 @@ int main(int argc, char** argv) {
     const double dt = period / 120;
     csv_writer rc(out / "reduced_vs_full.csv",
                   "dmu,reduced_amplitude,full_amplitude,relative_difference,reduced_period,full_period,full_seconds");
+    struct marched_point {
+      double dmu, reduced_amplitude, reduced_period, full_amplitude, full_period, full_seconds;
+      bool compared = false;
+    };
+    std::vector<marched_point> marched;
     std::vector<double> sweep = {1e-5, 3e-5, 7e-5, 1.5e-4, 3e-4, 5e-4, 7.5e-4, 1e-3};
     if (quick) sweep = {7e-5, 7.5e-4};
     std::printf("  %10s %14s %14s %10s %12s %12s %8s\n", "dmu", "reduced", "full", "rel.diff", "T reduced",
@@ -263,6 +272,70 @@ int main(int argc, char** argv) {
       std::printf("  %10.2e %14.6e %14.6e %+10.4f %12.6f %12.6f %8.2f\n", dmu, amp, run.cycle.amplitude, rel, rp,
                   run.cycle.period, run.seconds);
       rc.row({dmu, amp, run.cycle.amplitude, rel, rp, run.cycle.period, run.seconds});
+      marched.push_back({dmu, amp, rp, run.cycle.amplitude, run.cycle.period, run.seconds, false});
+    }
+
+    // ---------------------------------------------------------------- LCO branch: harmonic balance
+    std::cout << "\n== LCO branch by harmonic balance, continued in amplitude from the Hopf point (" << cells
+              << " cells)\n";
+    {
+      const vec<double> probe = vec<double>::Unit(r.size(), outlet);
+      // cost unit: one steady solve at mu* from the rest state (as in the Hopf table)
+      const auto ts = clk::now();
+      equilibrium_below_fold(r, hp.mu);
+      const double steady = seconds_since(ts);
+      csv_writer lc(out / "lco_branch.csv", "harmonics,mu,period,theta_amplitude,stable,newton_iterations,seconds");
+      csv_writer cc2(out / "lco_compare.csv",
+                     "mu,dmu,hb_amplitude,hb_period,reduced_amplitude,reduced_period,full_amplitude,full_period,"
+                     "hb_vs_full,hb_seconds,full_seconds");
+      std::vector<double> targets;
+      for (const auto& m : marched) targets.push_back(hp.mu + m.dmu);
+      for (int h : {1, 2, 3, 5, 8}) {
+        // first cycle: amplitude 1e-3 of Theta(x=1) on the critical eigenvector, mu from the reduced model
+        const double a0 = 1e-3;
+        const double dmu0 = std::pow(a0 / std::max(1e-300, model.component_amplitude(outlet, 1e-4).first), 2) * 1e-4;
+        const lco_solution start =
+            solve_lco(r, lco_guess_from_hopf(hp, probe, a0, h, hp.mu + dmu0), probe, lco_fix::amplitude);
+        lco_branch_options bo;
+        bo.mu_scale = 1e-3;
+        bo.amplitude_scale = 1e-2;
+        bo.step = 0.05;
+        bo.max_step = 0.5;
+        bo.mu_targets = targets;
+        bo.mu_min = hp.mu - 2e-3;  // H = 1 turns back (subcritical) towards a = 0
+        bo.mu_max = hp.mu + 2e-3;
+        bo.amplitude_max = 0.06;
+        bo.max_points = 200;
+        int points = 0, stable = 0;
+        double seconds = 0;
+        const auto tb = clk::now();
+        const lco_branch b = trace_lco_branch(r, start, probe, bo, [&](const lco_branch_point& p) {
+          const bool st = p.floquet && p.floquet->stable;
+          lc.row({(long long)h, p.cycle.mu, p.cycle.period(), p.probe_amplitude, (long long)st,
+                  (long long)p.cycle.newton_iterations, p.seconds});
+          ++points;
+          stable += st;
+          seconds += p.seconds;
+          if (h == 5 && p.landed)
+            for (auto& m : marched)
+              if (!m.compared && std::abs(hp.mu + m.dmu - p.cycle.mu) < 1e-12) {
+                m.compared = true;  // the first landing: the branch folds back over mu later
+                const double rel = p.probe_amplitude / m.full_amplitude - 1;
+                cc2.row({p.cycle.mu, m.dmu, p.probe_amplitude, p.cycle.period(), m.reduced_amplitude, m.reduced_period,
+                         m.full_amplitude, m.full_period, rel, p.seconds, m.full_seconds});
+                std::printf("  dmu %9.2e  HB %.6e (T %.6f)  reduced %.6e  BDF2 %.6e (T %.6f)  HB/BDF2 - 1 %+.2e"
+                            "  HB solve %.3f s = %.1f steady solves (+ Hill %.3f s; BDF2 %.2f s)\n",
+                            m.dmu, p.probe_amplitude, p.cycle.period(), m.reduced_amplitude, m.full_amplitude,
+                            m.full_period, rel, p.cycle.seconds, p.cycle.seconds / steady, p.seconds - p.cycle.seconds,
+                            m.full_seconds);
+              }
+          return false;
+        });
+        std::printf("  H = %d: %d points (%d stable) up to mu* + %.3g, Theta(1) amplitude %.4f; %.2f s (%s)\n", h,
+                    points, stable, b.points.back().cycle.mu - hp.mu, b.points.back().probe_amplitude,
+                    seconds_since(tb), b.stop_reason.c_str());
+      }
+      std::printf("  one steady solve: %.4f s\n", steady);
     }
 
     // ---------------------------------------------------------------- time histories

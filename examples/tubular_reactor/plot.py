@@ -115,6 +115,40 @@ def lco(out):
     plt.close(fig)
 
 
+def lco_branch(out):
+    """Theta(1) amplitude against mu - mu* by harmonic balance (per H, stable solid, unstable
+    dotted), the reduced model and the BDF2 runs."""
+    path = os.path.join(out, "lco_branch.csv")
+    cmp_path = os.path.join(out, "lco_compare.csv")
+    if not (os.path.exists(path) and os.path.exists(cmp_path)):
+        return
+    rows, cmp = read(path), read(cmp_path)
+    mu_star = float(cmp[0]["mu"]) - float(cmp[0]["dmu"])
+    fig, ax = plt.subplots(figsize=(7, 4.8))
+    colours = {1: "tab:orange", 2: "tab:green", 3: "tab:purple", 5: "tab:blue", 8: "k"}
+    for h in sorted({int(r["harmonics"]) for r in rows}):
+        pts = [r for r in rows if int(r["harmonics"]) == h]
+        x = [float(r["mu"]) - mu_star for r in pts]
+        y = [float(r["theta_amplitude"]) for r in pts]
+        st = [int(r["stable"]) for r in pts]
+        c = colours.get(h, "gray")
+        for k in range(len(pts) - 1):  # segment style by the stability of its ends
+            style = "-" if st[k] and st[k + 1] else ":"
+            ax.plot(x[k:k + 2], y[k:k + 2], style, color=c, lw=1.2,
+                    label=f"harmonic balance, H = {h}" if k == 0 else None)
+    d = col(cmp, "dmu")
+    ax.plot(d, col(cmp, "reduced_amplitude"), "r^", label="reduced 2-DOF model")
+    ax.plot(d, col(cmp, "full_amplitude"), "ks", mfc="none", label="BDF2 time marching")
+    ax.set_xlabel(r"$\mu - \mu^*$")
+    ax.set_ylabel(r"LCO amplitude of $\Theta(x=1)$ (half peak-to-peak)")
+    ax.set_title("LCO branch (solid: stable, dotted: unstable by Hill's method)", fontsize=9)
+    ax.legend(fontsize=8)
+    ax.grid(alpha=0.3)
+    fig.tight_layout()
+    fig.savefig(os.path.join(out, "lco_branch.png"), dpi=130)
+    plt.close(fig)
+
+
 def histories(out):
     for path in sorted(glob.glob(os.path.join(out, "history_*.csv"))):
         rows = read(path)
@@ -134,7 +168,7 @@ def histories(out):
 
 def main():
     out = sys.argv[1] if len(sys.argv) > 1 else "out/tubular_reactor"
-    for f in (branch, coefficients, damping, lco, histories):
+    for f in (branch, coefficients, damping, lco, lco_branch, histories):
         f(out)
     print(f"plot.py: wrote PNGs to {out}")
 

@@ -480,7 +480,7 @@ struct lco_branch_point {
   double probe_amplitude = 0;           ///< half peak-to-peak of the probe (probe_peak_amplitude)
   std::optional<floquet_result> floquet;  ///< when stability is computed
   bool landed = false;                  ///< on a listed mu target
-  double seconds = 0;                   ///< wall time of the step (corrector and stability)
+  double seconds = 0;                   ///< wall time of the step with the stability (cycle.seconds: without)
 };
 
 struct lco_branch_options {
@@ -532,8 +532,8 @@ lco_branch trace_lco_branch(const S& sys, const lco_solution& start, const vec<d
     p.probe_amplitude = probe_peak_amplitude(p.cycle, probe);
     if (hill) p.floquet = hill_floquet(sys, p.cycle, o.hill);
     p.landed = landed;
+    p.cycle.seconds = seconds;
     p.seconds = seconds + std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    p.cycle.seconds = p.seconds;
     if (o.log) {
       *o.log << who << ": point " << out.points.size() << "  mu " << p.cycle.mu << "  a " << p.cycle.amplitude
              << "  peak " << p.probe_amplitude << "  omega " << p.cycle.omega << "  Newton " << iterations;
