@@ -12,6 +12,7 @@
 #include <cmath>
 #include <numbers>
 
+#include "support/aerofoil_cases.hpp"
 #include "support/error_messages.hpp"
 #include "support/lco_test_systems.hpp"
 
@@ -252,6 +253,53 @@ TEST(HarmonicBalance, TubularReactorCycleMatchesBdf2TimeMarching) {
   const double hb_amplitude = p.probe_amplitude;
   EXPECT_NEAR(marched_amplitude / hb_amplitude, 1.0, 0.01);
   EXPECT_NEAR(marched_period / period, 1.0, 0.005);
+}
+
+TEST(HarmonicBalance, KrylovStrategyEqualsSparseLuOnTheReactor) {
+  const tubular_reactor r(16);
+  vec<double> w = r.rest_state();
+  for (int k = 1; k <= 8; ++k) w = newton(r, w, 0.16 * k / 8).x;
+  const hopf_point hp = solve_hopf(r, hopf_start(r, w, 0.16, 0.4)).point;
+  const vec<double> e = vec<double>::Unit(r.size(), r.size() - 1);
+  const lco_solution g = lco_guess_from_hopf(hp, e, 0.01, 4);
+  harmonic_balance_options ho;
+  ho.tolerance = 1e-11;
+  const lco_solution direct = solve_lco(r, g, e, lco_fix::amplitude, std::nullopt, ho);
+  const lco_solution krylov = solve_lco(r, g, e, lco_fix::amplitude, std::nullopt, ho, hb_krylov<2>{});
+  EXPECT_NEAR(krylov.mu, direct.mu, 1e-10 * std::abs(direct.mu));
+  EXPECT_NEAR(krylov.omega, direct.omega, 1e-9 * direct.omega);
+  EXPECT_LT((krylov.instances - direct.instances).cwiseAbs().maxCoeff(), 1e-9);
+  EXPECT_EQ(krylov.newton_iterations, direct.newton_iterations);
+  EXPECT_GT(krylov.linear_iterations, 0);
+  EXPECT_EQ(direct.linear_iterations, 0);
+}
+
+TEST(HarmonicBalance, KrylovStrategyEqualsSparseLuOnTheAerofoil) {
+  // heavy pitch-plunge NACA 0012, very coarse grid, M = 0.5: the pitch cycle of 0.01 rad
+  const auto s = test_support::heavy_very_coarse_aerofoil(0.5);
+  const vec<double> w = s.steady_equilibrium();
+  hopf_options hop;
+  hop.fixed_equilibrium = true;
+  const hopf_result h = solve_hopf(s, hopf_start(s, w, 4.6, 0.22), hop);
+  ASSERT_TRUE(h.report.converged);
+  const vec<double> e = vec<double>::Unit(s.size(), s.flow_size() + 2);  // pitch angle
+  const lco_solution g = lco_guess_from_hopf(h.point, e, 0.01, 2);
+  harmonic_balance_options ho;
+  ho.tolerance = 1e-10;
+  const auto t0 = std::chrono::steady_clock::now();
+  const lco_solution direct = solve_lco(s, g, e, lco_fix::amplitude, std::nullopt, ho);
+  const auto t1 = std::chrono::steady_clock::now();
+  const lco_solution krylov = solve_lco(s, g, e, lco_fix::amplitude, std::nullopt, ho, hb_krylov<4>{});
+  const auto t2 = std::chrono::steady_clock::now();
+  std::printf("aerofoil (n = %ld, H = 2): Ubar %.10f (Hopf %.10f), omega %.8f; sparse LU %d Newton %.2f s, Krylov %d Newton"
+              " %d GMRES %.2f s\n",
+              long(s.size()), krylov.mu, h.point.mu, krylov.omega, direct.newton_iterations,
+              std::chrono::duration<double>(t1 - t0).count(), krylov.newton_iterations, krylov.linear_iterations,
+              std::chrono::duration<double>(t2 - t1).count());
+  EXPECT_NEAR(krylov.mu, direct.mu, 1e-8 * std::abs(direct.mu));
+  EXPECT_NEAR(krylov.omega, direct.omega, 1e-8 * direct.omega);
+  EXPECT_LT((krylov.instances - direct.instances).cwiseAbs().maxCoeff(), 1e-7);
+  EXPECT_NE(krylov.mu, h.point.mu);  // a finite cycle: off the Hopf point
 }
 
 TEST(HarmonicBalance, BadInputIsRefusedAndNonConvergenceIsReported) {

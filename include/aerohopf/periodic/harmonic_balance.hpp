@@ -49,7 +49,10 @@
 #include "../bifurcation/curve_stepper.hpp"
 #include "../bifurcation/hopf_point.hpp"
 #include "../error.hpp"
+#include "../linalg/bordered_block_matrix.hpp"
 #include "../linalg/direct.hpp"
+#include "../linalg/krylov.hpp"
+#include "../nonlinear/block_system.hpp"
 #include "../nonlinear/system.hpp"
 
 namespace aerohopf {
@@ -76,6 +79,7 @@ struct lco_solution {
   double mu = 0;               ///< parameter
   double amplitude = 0;        ///< first-harmonic cosine coefficient of the probe
   int newton_iterations = 0;
+  int linear_iterations = 0;   ///< Krylov iterations of the solve (0 for the direct strategy)
   double residual = 0;         ///< ||F||_inf at the solution
   double seconds = 0;          ///< wall time of the solve
 
@@ -219,6 +223,10 @@ class harmonic_balance_equations {
   Eigen::Index omega_index() const { return nn_ * n_; }
   Eigen::Index mu_index() const { return nn_ * n_ + 1; }
   Eigen::Index amplitude_index() const { return nn_ * n_ + 2; }
+  const Eigen::MatrixXd& differentiation() const { return d_; }
+  /// The phase and amplitude rows' state parts (N n entries).
+  vec<double> phase_row() const { return probe_row(sin_); }
+  vec<double> amplitude_row() const { return probe_row(cos_); }
 
   vec<double> pack(const lco_solution& s) const {
     vec<double> x(unknowns());
@@ -303,6 +311,11 @@ class harmonic_balance_equations {
   }
 
  private:
+  vec<double> probe_row(const std::vector<double>& weight) const {
+    vec<double> r(nn_ * n_);
+    for (int j = 0; j < nn_; ++j) r.segment(j * n_, n_) = weight[std::size_t(j)] * probe_;
+    return r;
+  }
   template <class M>
   static void add_block(std::vector<Eigen::Triplet<double>>& t, const M& a, Eigen::Index r0, Eigen::Index c0) {
     if constexpr (is_sparse_matrix_v<M>) {
@@ -326,19 +339,21 @@ class harmonic_balance_equations {
 struct hb_newton_outcome {
   vec<double> x;
   int iterations = 0;
+  int linear_iterations = 0;
   double residual = 0;
 };
 
-/// Newton on (F(x), c.x - value) = 0 from x0; throws convergence_error on failure.
-template <dynamical_system S>
+/// Newton on (F(x), c.x - value) = 0 from x0 with the linear solver `lin` (lin(x, c, rhs) =
+/// [F_x; c^T]^{-1} rhs); throws convergence_error on failure.
+template <dynamical_system S, class Linear>
 hb_newton_outcome hb_newton(const harmonic_balance_equations<S>& eq, vec<double> x, const vec<double>& c,
-                            double value, const harmonic_balance_options& o, const char* who) {
-  direct_solver<Eigen::SparseMatrix<double>> lu(o.label + ": sparse LU of the harmonic-balance Jacobian");
+                            double value, const harmonic_balance_options& o, const char* who, Linear& lin) {
   const auto describe = [&](int it, double fn) {
     return concat(who, " (", o.label, "): Newton iteration ", it, ": ||F||_inf = ", fn, " (H = ", (eq.instances() - 1) / 2,
                   ", omega = ", x[eq.omega_index()], ", mu = ", x[eq.mu_index()], ", a = ", x[eq.amplitude_index()],
                   ")");
   };
+  const int linear_before = lin.iterations();
   for (int it = 0;; ++it) {
     vec<double> f(eq.unknowns());
     f.head(eq.unknowns() - 1) = eq.residual(x);
@@ -347,12 +362,15 @@ hb_newton_outcome hb_newton(const harmonic_balance_equations<S>& eq, vec<double>
     if (o.log) *o.log << o.label << ": iteration " << it << "  ||F||_inf " << fn << "  omega " << x[eq.omega_index()]
                       << "  mu " << x[eq.mu_index()] << "  a " << x[eq.amplitude_index()] << "\n";
     if (!std::isfinite(fn)) throw convergence_error(describe(it, fn) + ": the residual is not finite");
-    if (fn <= o.tolerance) return {std::move(x), it, fn};
+    if (fn <= o.tolerance) return {std::move(x), it, lin.iterations() - linear_before, fn};
     if (it >= o.max_iterations)
       throw convergence_error(describe(it, fn) + concat(": not converged to ", o.tolerance, " in ", o.max_iterations,
                                                         " iterations"));
-    lu.compute(eq.jacobian(x, c));
-    x -= lu.solve(f);
+    try {
+      x -= lin(x, c, f);
+    } catch (...) {
+      rethrow_with_context(describe(it, fn) + ": ");
+    }
     if (!x.allFinite()) throw convergence_error(describe(it + 1, NAN) + ": the Newton update is not finite");
     if (!(x[eq.omega_index()] > 0))
       throw convergence_error(describe(it + 1, fn) + ": the frequency left (0, inf): no cycle near the guess");
@@ -381,12 +399,160 @@ void check_guess(const S& sys, const lco_solution& g, const vec<double>& probe, 
 }
 }  // namespace internal
 
+/// The linear solver of the harmonic-balance Newton iterations by sparse LU of the assembled
+/// Jacobian (any system; the default).
+struct hb_direct {
+  template <dynamical_system S>
+  struct solver {
+    const internal::harmonic_balance_equations<S>* eq;
+    direct_solver<Eigen::SparseMatrix<double>> lu{"harmonic balance: sparse LU of the Jacobian"};
+    vec<double> operator()(const vec<double>& x, const vec<double>& c, const vec<double>& rhs) {
+      lu.compute(eq->jacobian(x, c));
+      return lu.solve(rhs);
+    }
+    int iterations() const { return 0; }
+  };
+  template <dynamical_system S>
+  solver<S> make(const internal::harmonic_balance_equations<S>& eq, const S&, const char*) const {
+    return solver<S>{&eq};
+  }
+};
+
+/// The linear solver by GMRES with the harmonic preconditioner, for CFD-sized systems: the exact
+/// Jacobians A(w_j) of every instance in bordered block form (krylov_exact_jacobian<B>, flow
+/// blocks of B plus the structural border), and as preconditioner the exact inverse of
+/// blockdiag(P) - omega D (x) I with P the preconditioning (e.g. modified-order) matrix at the
+/// cycle's mean state: by a discrete Fourier transform over the instances it is P - i k omega I
+/// for harmonic k = 0 .. H, each by a complex bordered BILU(k) (the shifted solves of the Hopf
+/// path), and the three border unknowns (omega, mu, a) with their rows are eliminated exactly
+/// around it (a 3 x 3 Schur complement). Near onset the cycle's instances differ little from
+/// their mean, so GMRES needs few iterations; they grow with the amplitude.
+template <int B>
+struct hb_krylov {
+  int fill_level = 1;                  ///< k of each BILU(k)
+  double relative_tolerance = 1e-8;    ///< of each GMRES solve
+  int max_iterations = 400;
+  int restart = 100;
+
+  template <dynamical_system S>
+  class solver {
+   public:
+    using C = std::complex<double>;
+    solver(const hb_krylov& o, const internal::harmonic_balance_equations<S>& eq, const S& sys, const char* who)
+        : o_(o), eq_(&eq), sys_(&sys), who_(who) {}
+    int iterations() const { return iterations_; }
+
+    vec<double> operator()(const vec<double>& x, const vec<double>& c, const vec<double>& rhs) {
+      const auto& eq = *eq_;
+      const int nn = eq.instances(), h = (nn - 1) / 2;
+      const Eigen::Index n = eq.n(), m = nn * n;
+      const double omega = x[eq.omega_index()], mu = x[eq.mu_index()];
+      const Eigen::Map<const Eigen::MatrixXd> w(x.data(), n, nn);
+      const Eigen::MatrixXd& d = eq.differentiation();
+      exact_.clear();
+      for (int j = 0; j < nn; ++j) exact_.push_back(krylov_exact_jacobian<B>(*sys_, vec<double>(w.col(j)), mu, who_));
+      const vec<double> wbar = w.rowwise().mean();
+      const auto pre = krylov_jacobians<B>(*sys_, wbar, mu, who_).preconditioning;
+      ilu_.clear();
+      for (int k = 0; k <= h; ++k) {
+        block_ilu_options bo;
+        bo.fill_level = o_.fill_level;
+        bo.context = internal::concat(who_, ": BILU(", o_.fill_level, ") of P - i ", k, " omega I");
+        ilu_.emplace_back(bo);
+        ilu_.back().compute(pre, C(0.0, k * omega));
+      }
+      // state part of the operator: y_j = A_j x_j - omega sum_k D_jk x_k
+      Eigen::MatrixXd dw = w * d.transpose();
+      auto state_op = [&](const vec<double>& v, vec<double>& y) {
+        const Eigen::Map<const Eigen::MatrixXd> vm(v.data(), n, nn);
+        Eigen::Map<Eigen::MatrixXd> ym(y.data(), n, nn);
+        ym.noalias() = -omega * (vm * d.transpose());
+        for (int j = 0; j < nn; ++j) {
+          tmp_in_ = vm.col(j);
+          tmp_out_.resize(n);
+          exact_[std::size_t(j)].apply(tmp_in_, tmp_out_);
+          ym.col(j) += tmp_out_;
+        }
+      };
+      // the full operator [[state, U], [V, corner]]
+      Eigen::MatrixXd u = Eigen::MatrixXd::Zero(m, 3), v = Eigen::MatrixXd::Zero(3, m), corner = Eigen::MatrixXd::Zero(3, 3);
+      for (int j = 0; j < nn; ++j) {
+        const vec<double> wj = w.col(j);
+        u.block(j * n, 0, n, 1) = -dw.col(j);
+        u.block(j * n, 1, n, 1) = residual_d_mu(*sys_, wj, mu);
+      }
+      v.row(0) = eq.phase_row().transpose();
+      v.row(1) = eq.amplitude_row().transpose();
+      v.row(2) = c.head(m).transpose();
+      corner(1, 2) = -1;
+      corner.row(2) = c.tail(3).transpose();
+      auto op = [&](const vec<double>& z, vec<double>& y) {
+        vec<double> ys(m);
+        state_op(z.head(m), ys);
+        y.head(m) = ys + u * z.tail(3);
+        y.tail(3) = v * z.head(m) + corner * z.tail(3);
+      };
+      // preconditioner of the state part: Fourier transform, shifted BILU per harmonic, back
+      auto state_pre = [&](const vec<double>& r, vec<double>& z) {
+        const Eigen::Map<const Eigen::MatrixXd> rm(r.data(), n, nn);
+        Eigen::Map<Eigen::MatrixXd> zm(z.data(), n, nn);
+        zm.setZero();
+        for (int k = 0; k <= h; ++k) {
+          rk_ = vec<C>::Zero(n);
+          for (int j = 0; j < nn; ++j) rk_ += rm.col(j).cast<C>() * std::polar(1.0 / nn, -2 * std::numbers::pi * k * j / nn);
+          zk_.resize(n);
+          ilu_[std::size_t(k)].apply(rk_, zk_);
+          for (int j = 0; j < nn; ++j)
+            zm.col(j) += (k == 0 ? 1.0 : 2.0) * (zk_ * std::polar(1.0, 2 * std::numbers::pi * k * j / nn)).real();
+        }
+      };
+      internal::border_elimination<double> border;
+      border.compute(state_pre, m, u, v, corner, internal::concat(who_, ": harmonic-balance border"));
+      auto pre_full = [&](const vec<double>& r, vec<double>& z) { border.apply(state_pre, r, z); };
+      krylov_options ko;
+      ko.relative_tolerance = o_.relative_tolerance;
+      ko.max_iterations = o_.max_iterations;
+      ko.restart = o_.restart;
+      ko.record_history = false;
+      ko.context = internal::concat(who_, ": GMRES on the harmonic-balance Jacobian");
+      vec<double> dx = vec<double>::Zero(rhs.size());
+      const krylov_report rep = gmres<double>(op, pre_full, rhs, dx, ko);
+      iterations_ += rep.iterations;
+      if (!rep.converged)
+        throw convergence_error(internal::concat(ko.context, ": not converged in ", rep.iterations,
+                                                 " iterations (relative residual ", rep.relative_residual, ", ",
+                                                 rep.reason, ")"));
+      return dx;
+    }
+
+   private:
+    hb_krylov o_;
+    const internal::harmonic_balance_equations<S>* eq_;
+    const S* sys_;
+    const char* who_;
+    std::vector<bordered_block_matrix<double, B>> exact_;
+    std::vector<bordered_block_ilu<C, B>> ilu_;
+    vec<double> tmp_in_, tmp_out_;
+    vec<C> rk_, zk_;
+    int iterations_ = 0;
+  };
+  template <dynamical_system S>
+  solver<S> make(const internal::harmonic_balance_equations<S>& eq, const S& sys, const char* who) const {
+    require(fill_level >= 0 && std::isfinite(relative_tolerance) && relative_tolerance > 0 && max_iterations >= 1 &&
+                restart >= 1,
+            who, ": hb_krylov options out of range (fill_level ", fill_level, ", relative_tolerance ",
+            relative_tolerance, ", max_iterations ", max_iterations, ", restart ", restart, ")");
+    return solver<S>(*this, eq, sys, who);
+  }
+};
+
 /// Solves the harmonic-balance system from a guess with either the amplitude a or the parameter
 /// mu held at `value` (the guess's own value when nullopt). The number of harmonics is the guess's
 /// (resample() changes it). Throws convergence_error when Newton fails.
-template <dynamical_system S>
+template <dynamical_system S, class Strategy = hb_direct>
 lco_solution solve_lco(const S& sys, const lco_solution& guess, const vec<double>& probe, lco_fix fix,
-                       std::optional<double> value = std::nullopt, const harmonic_balance_options& o = {}) {
+                       std::optional<double> value = std::nullopt, const harmonic_balance_options& o = {},
+                       const Strategy& strategy = {}) {
   const char* who = "solve_lco";
   internal::check_hb_options(o, who);
   internal::check_guess(sys, guess, probe, who);
@@ -399,9 +565,11 @@ lco_solution solve_lco(const S& sys, const lco_solution& guess, const vec<double
   const double v = value.value_or(x[j]);
   require(std::isfinite(v), who, ": the fixed value is not finite");
   x[j] = v;
-  const auto r = internal::hb_newton(eq, x, c, v, o, who);
+  auto lin = strategy.make(eq, sys, who);
+  const auto r = internal::hb_newton(eq, x, c, v, o, who, lin);
   lco_solution s = eq.unpack(r.x);
   s.newton_iterations = r.iterations;
+  s.linear_iterations = r.linear_iterations;
   s.residual = r.residual;
   s.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return s;
@@ -506,9 +674,9 @@ struct lco_branch {
 /// metric of the options), from a solved start (solve_lco) towards larger amplitude or the
 /// options' mu_direction. Points are
 /// emitted to `on_point` as they are found (it may return true to stop) and returned.
-template <dynamical_system S, class OnPoint>
+template <dynamical_system S, class OnPoint, class Strategy = hb_direct>
 lco_branch trace_lco_branch(const S& sys, const lco_solution& start, const vec<double>& probe,
-                            const lco_branch_options& o, OnPoint&& on_point) {
+                            const lco_branch_options& o, OnPoint&& on_point, const Strategy& strategy = {}) {
   const char* who = "trace_lco_branch";
   internal::check_hb_options(o.newton, who);
   internal::check_guess(sys, start, probe, who);
@@ -523,11 +691,13 @@ lco_branch trace_lco_branch(const S& sys, const lco_solution& start, const vec<d
   const curve_metric metric(weight);
   const bool hill = o.stability && sys.size() * start.instance_count() <= o.hill.max_size;
   lco_branch out;
+  int last_linear = start.linear_iterations;
   auto record = [&](const vec<double>& x, int iterations, double residual, bool landed, double seconds) {
     const auto t0 = std::chrono::steady_clock::now();
     lco_branch_point p;
     p.cycle = eq.unpack(x);
     p.cycle.newton_iterations = iterations;
+    p.cycle.linear_iterations = last_linear;
     p.cycle.residual = residual;
     p.probe_amplitude = probe_peak_amplitude(p.cycle, probe);
     if (hill) p.floquet = hill_floquet(sys, p.cycle, o.hill);
@@ -547,10 +717,12 @@ lco_branch trace_lco_branch(const S& sys, const lco_solution& start, const vec<d
     double residual = 0;
   };
   double last_residual = start.residual;
+  auto lin = strategy.make(eq, sys, who);
   curve_problem prob{
       [&](const curve_request& q, std::string& why) -> std::optional<corrected> {
         try {
-          const auto r = internal::hb_newton(eq, q.x0, q.c, q.value, o.newton, who);
+          const auto r = internal::hb_newton(eq, q.x0, q.c, q.value, o.newton, who, lin);
+          last_linear = r.linear_iterations;
           corrected c;
           c.x = r.x;
           c.iterations = r.iterations;
@@ -565,9 +737,7 @@ lco_branch trace_lco_branch(const S& sys, const lco_solution& start, const vec<d
         return std::nullopt;
       },
       [&](const vec<double>& x, const vec<double>& c) -> vec<double> {  // [F_x; c^T] t = e_last
-        direct_solver<Eigen::SparseMatrix<double>> lu(internal::concat(who, ": tangent"));
-        lu.compute(eq.jacobian(x, c));
-        return lu.solve(vec<double>::Unit(nx, nx - 1));
+        return lin(x, c, vec<double>::Unit(nx, nx - 1));
       },
       [&](const vec<double>& x, const curve_point_info& info) {
         return record(x, info.start ? start.newton_iterations : info.iterations,
