@@ -22,6 +22,8 @@
 //   --verify-grid g             grid of the time-marching verification (default medium)
 //   --contact-smoothing d       contact-switch smoothing of the reduced-model part (default 0.05)
 //   --crossing-medium           the crossing check on the medium grid too (default: coarse and coarser)
+//   --lco-march                 BDF2 runs to the limit cycle at 1.005 and 1.02 Ubar* (from 0.9 and 1.1
+//                               times the harmonic-balance cycle, 60 periods each) against harmonic balance
 //   --quick                     coarse grid, M = 0.5 .. 0.8 step 0.1, shorter time marching
 //   --verbose                   a line per Hopf Newton iteration
 //
@@ -38,6 +40,10 @@
 //                               plunge, 1 pitch); vg_flutter_<case>_<grid>_M<mach>.csv its g = 0 crossings
 //   verification.csv, history_<case>_M<mach>_<factor>.csv       time marching at 0.97 / 1.03 Ubar*
 //   costs.csv                                                   cost ratios to the steady solve
+//   lco_branch_heavy_coarse_M0.80.csv    the LCO branch by harmonic balance (1, 2, 3 harmonics), heavy case,
+//                               coarse grid, M = 0.8 (harmonics,ubar,omega,alpha_amplitude,stable,
+//                               newton_iterations,seconds,steady_seconds); lco_march_heavy_coarse_M0.80.csv
+//                               the BDF2 runs of --lco-march
 //   reduced_coefficients.csv, reduced_damping.csv, reduced_lco.csv, reduced_envelope.csv   reduced model
 // plot.py in this folder turns them into PNGs. Exit status 1 if a check fails.
 #include <aerohopf/bifurcation/flutter_boundary.hpp>
@@ -221,6 +227,8 @@ options parse(int argc, char** argv) {
       o.verify = false;
     } else if (a == "--skip-reduced") {
       o.reduced = false;
+    } else if (a == "--lco-march") {
+      o.lco_march = true;
     } else if (a == "--vg-mach") {
       o.vg_mach = number();
       require(o.vg_mach > 0 && o.vg_mach < 1, "--vg-mach must be in (0, 1)");

@@ -11,6 +11,7 @@
 #include <aerohopf/io/csv.hpp>
 #include <aerohopf/linalg/krylov_solver.hpp>
 #include <aerohopf/models/aerofoil_family.hpp>
+#include <aerohopf/periodic.hpp>
 #include <aerohopf/reduction.hpp>
 #include <aerohopf/scalar/qd.hpp>
 #include <aerohopf/time/bdf2.hpp>
@@ -49,6 +50,7 @@ struct options {
   int fill = flutter_boundary_options{}.fill_level;
   double contact_smoothing = 0.05;  // of the reduced model's discretisation (osher_flux.hpp)
   bool spectra = true, boundaries = true, jump_check = true, verify = true, reduced = true, quick = false;
+  bool lco_march = false;  // BDF2 to the limit cycle against the harmonic-balance cycles
   bool vg = true;
   double vg_mach = 0.80;  // transonic (shocks on both surfaces), as the reduced model
   std::optional<grid_level> vg_grid;  // default: the first of grids
@@ -426,6 +428,115 @@ inline void verification_part(const options& o, const boundaries& all, std::vect
 // ---------------------------------------------------------------------------------------------
 // Part 4: centre-manifold reduced model at a transonic Mach number of the heavy case.
 
+/// The LCO branch of the full system by harmonic balance (Newton-Krylov), continued in pitch
+/// amplitude from the Hopf point, landing on 1.001 .. 1.05 Ubar*, for 1, 2 and 3 harmonics;
+/// the reduced model beside it. Hill's dense stability is out of reach at this size: a cycle is
+/// marked stable where Ubar grows with the amplitude (exchange of stability with the stable
+/// equilibrium below Ubar*, valid up to the first fold or secondary bifurcation).
+inline void lco_branch_part(const options& o, const aerofoil_system& s, const steady_result& st, const hopf_point& hp,
+                            const centre_manifold_model& model, Eigen::Index ia, double side) {
+  std::cout << "\n  LCO branch by harmonic balance (Newton-Krylov, BILU(" << o.fill
+            << ") per harmonic), pitch amplitude against Ubar:\n";
+  const vec<double> probe = vec<double>::Unit(s.size(), ia);
+  const std::string name = "lco_branch_heavy_coarse_M0.80.csv";
+  csv_writer lc(o.out / name, "harmonics,ubar,omega,alpha_amplitude,stable,newton_iterations,seconds,steady_seconds");
+  std::vector<double> factors = {1.001, 1.002, 1.005, 1.01, 1.02, 1.05};
+  if (o.quick) factors = {1.002, 1.01};
+  std::vector<double> targets;
+  for (double f : factors) targets.push_back(hp.mu * (1 + side * (f - 1)));
+  if (side < 0) std::reverse(targets.begin(), targets.end());
+  std::vector<lco_solution> cycles;  // the landed cycles of the last H
+  for (int h : o.quick ? std::vector<int>{1, 2} : std::vector<int>{1, 2, 3}) {
+    hb_krylov<4> kr;
+    kr.fill_level = o.fill;
+    harmonic_balance_options ho;
+    ho.tolerance = 1e-10;
+    ho.label = "harmonic balance H = " + std::to_string(h);
+    const auto t0 = clk::now();
+    // first cycle: pitch amplitude 2e-4 rad (first harmonic) from the critical eigenvector
+    const lco_solution start =
+        solve_lco(s, lco_guess_from_hopf(hp, probe, 2e-4, h), probe, lco_fix::amplitude, std::nullopt, ho, kr);
+    lco_branch_options bo;
+    bo.newton = ho;
+    bo.mu_scale = 0.01 * hp.mu;
+    bo.amplitude_scale = 0.01;
+    bo.step = 0.1;
+    bo.max_step = 0.5;
+    bo.mu_targets = targets;
+    bo.mu_min = hp.mu * 0.9;
+    bo.mu_max = hp.mu * 1.06;
+    bo.amplitude_max = 0.2;
+    bo.max_points = 80;
+    bo.stability = false;
+    std::optional<double> last_mu;
+    int landed = 0;
+    cycles.clear();
+    const lco_branch b = trace_lco_branch(
+        s, start, probe, bo,
+        [&](const lco_branch_point& p) {
+          const bool stable = last_mu ? side * (p.cycle.mu - *last_mu) > 0 : true;
+          last_mu = p.cycle.mu;
+          lc.row({(long long)h, p.cycle.mu, p.cycle.omega, p.probe_amplitude, (long long)stable,
+                  (long long)p.cycle.newton_iterations, p.cycle.seconds, st.seconds});
+          if (p.landed) {
+            ++landed;
+            cycles.push_back(p.cycle);
+            const double dmu = p.cycle.mu - hp.mu;
+            const auto l = model.lco(dmu);
+            const double reduced = l.exists ? model.component_amplitude(ia, dmu).first : NAN;
+            std::printf("    H = %d  Ubar = %.6f (%.3f Ubar*)  pitch amplitude %.6f rad (reduced model %.6f, %+.1f %%)  "
+                        "omega %.6f (Hopf %.6f)  Newton %d, GMRES %d  %.1f s = %.2f steady solves\n",
+                        h, p.cycle.mu, p.cycle.mu / hp.mu, p.probe_amplitude, reduced,
+                        100 * (reduced / p.probe_amplitude - 1), p.cycle.omega, hp.omega, p.cycle.newton_iterations,
+                        p.cycle.linear_iterations, p.cycle.seconds, p.cycle.seconds / st.seconds);
+          }
+          return landed == int(targets.size());
+        },
+        kr);
+    std::printf("    H = %d: %zu points, %d landed, %.1f s in all (%s)\n", h, b.points.size(), landed, seconds_since(t0),
+                b.stop_reason.empty() ? "all targets landed" : b.stop_reason.c_str());
+  }
+  std::printf("    one steady solve: %.2f s; wrote %s\n", st.seconds, name.c_str());
+  if (!o.lco_march) return;
+  // BDF2 to the limit cycle from inside and outside it: the cycle's state at phase 0 with its
+  // displacement from the mean scaled by 0.9 and 1.1, marched for `periods` periods; amplitude
+  // (half peak-to-peak of the pitch) and period over the last three.
+  std::cout << "\n  BDF2 (dt = 0.125) to the limit cycle against harmonic balance (H = " << cycles.front().harmonics
+            << "):\n";
+  csv_writer mc(o.out / "lco_march_heavy_coarse_M0.80.csv",
+                "ubar,hb_amplitude,hb_omega,start_scale,march_amplitude,march_omega,periods,seconds");
+  const int periods = o.quick ? 20 : 60;
+  for (const lco_solution& c : cycles) {
+    if (o.quick ? std::abs(c.mu / hp.mu - 1 - side * 0.01) > 1e-9
+                : std::abs(c.mu / hp.mu - 1 - side * 0.005) > 1e-9 && std::abs(c.mu / hp.mu - 1 - side * 0.02) > 1e-9)
+      continue;
+    const double hb_amp = probe_peak_amplitude(c, probe);
+    for (double scale : {0.9, 1.1}) {
+      const vec<double> w0 = c.mean() + scale * (c.state(0.0) - c.mean());
+      const auto mh = march(s, c.mu, w0, periods * c.period(),
+                            "lco_" + fixed(c.mu / hp.mu, 3) + "_" + fixed(scale, 1), o);
+      double amax = -INFINITY, amin = INFINITY;
+      std::vector<double> peaks;
+      for (std::size_t k = 1; k + 1 < mh.t.size(); ++k) {
+        if (mh.t[k] > (periods - 3) * c.period()) amax = std::max(amax, mh.alpha[k]), amin = std::min(amin, mh.alpha[k]);
+        if (mh.t[k] > (periods - 6) * c.period() && mh.alpha[k] > mh.alpha[k - 1] && mh.alpha[k] >= mh.alpha[k + 1]) {
+          const double a2 = 0.5 * (mh.alpha[k + 1] - 2 * mh.alpha[k] + mh.alpha[k - 1]);
+          const double a1 = 0.5 * (mh.alpha[k + 1] - mh.alpha[k - 1]);
+          peaks.push_back(mh.t[k] - a1 / (2 * a2) * (mh.t[k + 1] - mh.t[k]));
+        }
+      }
+      const double amp = 0.5 * (amax - amin);
+      const double om = peaks.size() >= 2 ? 2 * std::numbers::pi * double(peaks.size() - 1) / (peaks.back() - peaks.front())
+                                          : NAN;
+      mc.row({c.mu, hb_amp, c.omega, scale, amp, om, (long long)periods, mh.seconds});
+      std::printf("    Ubar = %.6f (%.3f Ubar*), start %.1f x the cycle: after %d periods amplitude %.6f rad (HB %.6f, %+.2f %%),"
+                  " omega %.6f (HB %.6f, %+.3f %%), %.0f s\n",
+                  c.mu, c.mu / hp.mu, scale, periods, amp, hb_amp, 100 * (amp / hb_amp - 1), om, c.omega,
+                  100 * (om / c.omega - 1), mh.seconds);
+    }
+  }
+}
+
 inline void reduced_part(const options& o, const boundaries& all) {
   const structural_case& c = heavy_case;
   const grid_level g = level_named("coarse");
@@ -531,6 +642,7 @@ inline void reduced_part(const options& o, const boundaries& all) {
     std::printf("  LCO at Ubar = %.5f: pitch amplitude %.5f rad, frequency %.5f, %s\n", hp.mu + dmu, amp, l.frequency,
                 l.stable ? "stable" : "unstable");
   }
+  lco_branch_part(o, s, st, hp, model, ia, side);
   if (!o.verify) return;
 
   // Verification of the nonlinear term by time marching: the amplitude-dependent growth rate.

@@ -272,6 +272,20 @@ TEST(HarmonicBalance, KrylovStrategyEqualsSparseLuOnTheReactor) {
   EXPECT_EQ(krylov.newton_iterations, direct.newton_iterations);
   EXPECT_GT(krylov.linear_iterations, 0);
   EXPECT_EQ(direct.linear_iterations, 0);
+  hb_krylov<2> bad;
+  bad.fill_level = -1;
+  EXPECT_THROW(solve_lco(r, g, e, lco_fix::amplitude, std::nullopt, ho, bad), input_error);
+  bad = {};
+  bad.accept_tolerance = 1e-9;  // below relative_tolerance
+  EXPECT_THROW(solve_lco(r, g, e, lco_fix::amplitude, std::nullopt, ho, bad), input_error);
+  // a GMRES that cannot converge (one iteration, nothing accepted) ends the solve clearly
+  bad = {};
+  bad.max_iterations = 1;
+  bad.accept_tolerance = bad.relative_tolerance;
+  const std::string msg = test::error_of<convergence_error>(
+      [&] { solve_lco(r, g, e, lco_fix::amplitude, std::nullopt, ho, bad); });
+  EXPECT_TRUE(test::contains(msg, "GMRES on the harmonic-balance Jacobian")) << msg;
+  EXPECT_TRUE(test::contains(msg, "Newton iteration 0")) << msg;
 }
 
 TEST(HarmonicBalance, KrylovStrategyEqualsSparseLuOnTheAerofoil) {
