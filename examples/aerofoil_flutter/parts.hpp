@@ -503,6 +503,7 @@ inline void lco_branch_part(const options& o, const aerofoil_system& s, const st
   // (half peak-to-peak of the pitch) and period over the last three.
   std::cout << "\n  BDF2 (dt = 0.125) to the limit cycle against harmonic balance (H = " << cycles.front().harmonics
             << "):\n";
+  // start_scale 0: the amplitude where the envelopes' growth rate vanishes (both runs' samples)
   csv_writer mc(o.out / "lco_march_heavy_coarse_M0.80.csv",
                 "ubar,hb_amplitude,hb_omega,start_scale,march_amplitude,march_omega,periods,seconds");
   const int periods = o.quick ? 20 : 60;
@@ -511,6 +512,10 @@ inline void lco_branch_part(const options& o, const aerofoil_system& s, const st
                 : std::abs(c.mu / hp.mu - 1 - side * 0.005) > 1e-9 && std::abs(c.mu / hp.mu - 1 - side * 0.02) > 1e-9)
       continue;
     const double hb_amp = probe_peak_amplitude(c, probe);
+    // the envelopes' growth rate sigma(A) of both runs, a line through all samples: its zero is
+    // the marched cycle's amplitude (interpolated: the runs approach it from both sides)
+    double sx = 0, sy = 0, sxx = 0, sxy = 0;
+    int ns = 0;
     for (double scale : {0.9, 1.1}) {
       const vec<double> w0 = c.mean() + scale * (c.state(0.0) - c.mean());
       const auto mh = march(s, c.mu, w0, periods * c.period(),
@@ -526,6 +531,11 @@ inline void lco_branch_part(const options& o, const aerofoil_system& s, const st
         }
       }
       const double amp = 0.5 * (amax - amin);
+      for (const auto& e : amplitude_envelope(mh.t, mh.alpha, 1.5 * c.period())) {
+        if (!std::isfinite(e.growth_rate)) continue;
+        sx += e.amplitude, sy += e.growth_rate, sxx += e.amplitude * e.amplitude, sxy += e.amplitude * e.growth_rate;
+        ++ns;
+      }
       const double om = peaks.size() >= 2 ? 2 * std::numbers::pi * double(peaks.size() - 1) / (peaks.back() - peaks.front())
                                           : NAN;
       mc.row({c.mu, hb_amp, c.omega, scale, amp, om, (long long)periods, mh.seconds});
@@ -534,6 +544,12 @@ inline void lco_branch_part(const options& o, const aerofoil_system& s, const st
                   c.mu, c.mu / hp.mu, scale, periods, amp, hb_amp, 100 * (amp / hb_amp - 1), om, c.omega,
                   100 * (om / c.omega - 1), mh.seconds);
     }
+    const double s1 = (ns * sxy - sx * sy) / (ns * sxx - sx * sx), s0 = (sy - s1 * sx) / ns;
+    const double a_lc = -s0 / s1;
+    mc.row({c.mu, hb_amp, c.omega, 0.0, a_lc, NAN, (long long)periods, 0.0});
+    std::printf("    Ubar = %.6f: the envelopes' growth rate vanishes at amplitude %.6f rad (HB %.6f, %+.2f %%; %d samples,"
+                " d sigma / dA = %.4f)\n",
+                c.mu, a_lc, hb_amp, 100 * (a_lc / hb_amp - 1), ns, s1);
   }
 }
 
