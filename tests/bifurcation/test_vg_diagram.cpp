@@ -356,11 +356,9 @@ TEST(vg_diagram, refuses_bad_input_with_context) {
 // the Hopf point of the augmented-system Newton solve (an independent calculation).
 TEST(vg_diagram, aerofoil_zero_damping_is_the_hopf_point) {
   const auto s = test_support::heavy_very_coarse_aerofoil(0.5);
-  const vec<double> w = s.steady_equilibrium();
-  hopf_options ho;
-  ho.fixed_equilibrium = true;
-  const hopf_result h = solve_hopf(s, hopf_start(s, w, 4.6, 0.22), ho);
+  const hopf_result h = test_support::heavy_very_coarse_hopf(s);
   ASSERT_TRUE(h.report.converged);
+  const vec<double> w = h.point.w;
   const double ubar_star = std::abs(h.point.mu), omega_star = h.point.omega;
   std::vector<double> mus;
   for (int k = 0; k <= 24; ++k) mus.push_back((0.7025 + 0.025 * k) * ubar_star);

@@ -33,6 +33,13 @@ hopf_point origin_hopf(const polar_normal_form& s) {
   return hp;
 }
 
+/// The reactor's first Hopf point (16 cells) from the equilibrium at mu = 0.16.
+hopf_point reactor_hopf(const tubular_reactor& r) {
+  vec<double> w = r.rest_state();
+  for (int k = 1; k <= 8; ++k) w = newton(r, w, 0.16 * k / 8).x;
+  return solve_hopf(r, hopf_start(r, w, 0.16, 0.4)).point;
+}
+
 /// Van der Pol, x'' - mu (1 - x^2) x' + x = 0 as a first-order system (x, x').
 struct van_der_pol {
   using jacobian_type = Eigen::MatrixXd;
@@ -204,9 +211,7 @@ TEST(HarmonicBalance, VanDerPolCycleConvergesSpectrallyToThePublishedPeriod) {
 
 TEST(HarmonicBalance, TubularReactorCycleMatchesBdf2TimeMarching) {
   const tubular_reactor r(16);
-  vec<double> w = r.rest_state();
-  for (int k = 1; k <= 8; ++k) w = newton(r, w, 0.16 * k / 8).x;
-  const hopf_point hp = solve_hopf(r, hopf_start(r, w, 0.16, 0.4)).point;
+  const hopf_point hp = reactor_hopf(r);
   const vec<double> e = vec<double>::Unit(r.size(), r.size() - 1);  // Theta at the outlet
   const double dmu = 1e-3;
   lco_branch_options o;
@@ -257,9 +262,7 @@ TEST(HarmonicBalance, TubularReactorCycleMatchesBdf2TimeMarching) {
 
 TEST(HarmonicBalance, KrylovStrategyEqualsSparseLuOnTheReactor) {
   const tubular_reactor r(16);
-  vec<double> w = r.rest_state();
-  for (int k = 1; k <= 8; ++k) w = newton(r, w, 0.16 * k / 8).x;
-  const hopf_point hp = solve_hopf(r, hopf_start(r, w, 0.16, 0.4)).point;
+  const hopf_point hp = reactor_hopf(r);
   const vec<double> e = vec<double>::Unit(r.size(), r.size() - 1);
   const lco_solution g = lco_guess_from_hopf(hp, e, 0.01, 4);
   harmonic_balance_options ho;
@@ -291,10 +294,7 @@ TEST(HarmonicBalance, KrylovStrategyEqualsSparseLuOnTheReactor) {
 TEST(HarmonicBalance, KrylovStrategyEqualsSparseLuOnTheAerofoil) {
   // heavy pitch-plunge NACA 0012, very coarse grid, M = 0.5: the pitch cycle of 0.01 rad
   const auto s = test_support::heavy_very_coarse_aerofoil(0.5);
-  const vec<double> w = s.steady_equilibrium();
-  hopf_options hop;
-  hop.fixed_equilibrium = true;
-  const hopf_result h = solve_hopf(s, hopf_start(s, w, 4.6, 0.22), hop);
+  const hopf_result h = test_support::heavy_very_coarse_hopf(s);
   ASSERT_TRUE(h.report.converged);
   const vec<double> e = vec<double>::Unit(s.size(), s.flow_size() + 2);  // pitch angle
   const lco_solution g = lco_guess_from_hopf(h.point, e, 0.01, 2);
