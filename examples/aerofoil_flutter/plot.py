@@ -216,6 +216,43 @@ def reduced(out):
     save(fig, out, "reduced.png")
 
 
+def lco_branch(out):
+    """Pitch LCO amplitude against Ubar / Ubar*: harmonic balance per H (solid where marked
+    stable), the reduced model and the BDF2 runs to the cycle (--lco-march)."""
+    path = os.path.join(out, "lco_branch_heavy_coarse_M0.80.csv")
+    if not os.path.exists(path):
+        return
+    rows = read(path)
+    ubar_star = min(float(r["ubar"]) for r in rows if int(r["harmonics"]) == 1)  # the start: next to Ubar*
+    fig, ax = plt.subplots(figsize=(7.5, 5))
+    colours = {1: "tab:orange", 2: "tab:green", 3: "tab:blue", 5: "k"}
+    for h in sorted({int(r["harmonics"]) for r in rows}):
+        pts = [r for r in rows if int(r["harmonics"]) == h]
+        x = [float(r["ubar"]) / ubar_star for r in pts]
+        y = [float(r["alpha_amplitude"]) for r in pts]
+        st = [int(r["stable"]) for r in pts]
+        for k in range(len(pts) - 1):
+            ax.plot(x[k:k + 2], y[k:k + 2], "-" if st[k] and st[k + 1] else ":", color=colours.get(h, "gray"),
+                    label=f"harmonic balance, H = {h}" if k == 0 else None)
+    lpath = os.path.join(out, "reduced_lco.csv")
+    if os.path.exists(lpath):
+        lr = read(lpath)
+        ax.plot([float(r["ubar"]) / ubar_star for r in lr], col(lr, "alpha_amplitude"), "r--", label="reduced 2-DOF model")
+    mpath = os.path.join(out, "lco_march_heavy_coarse_M0.80.csv")
+    if os.path.exists(mpath):
+        m = read(mpath)
+        runs = [r for r in m if float(r["start_scale"]) > 0]
+        fits = [r for r in m if float(r["start_scale"]) == 0]
+        ax.plot([float(r["ubar"]) / ubar_star for r in runs], col(runs, "march_amplitude"), "ks", mfc="none",
+                label="BDF2 after 60 periods (from 0.9 and 1.1 x the cycle)")
+        if fits:
+            ax.plot([float(r["ubar"]) / ubar_star for r in fits], col(fits, "march_amplitude"), "k*", ms=10,
+                    label="BDF2: zero of the envelopes' growth rate")
+    finish_axes(ax, "$\\bar U / \\bar U^*$ (first point of the H = 1 branch)", "pitch LCO amplitude (rad)",
+                "heavy case, coarse grid, M = 0.8 (solid: stable, dotted: unstable)")
+    save(fig, out, "lco_branch.png")
+
+
 def main():
     out = sys.argv[1] if len(sys.argv) > 1 else "out/aerofoil_flutter"
     boundaries(out)
@@ -224,6 +261,7 @@ def main():
     histories(out)
     jump_check(out)
     reduced(out)
+    lco_branch(out)
     print("plots written to", out)
 
 
