@@ -40,7 +40,7 @@
 //                               plunge, 1 pitch); vg_flutter_<case>_<grid>_M<mach>.csv its g = 0 crossings
 //   verification.csv, history_<case>_M<mach>_<factor>.csv       time marching at 0.97 / 1.03 Ubar*
 //   costs.csv                                                   cost ratios to the steady solve
-//   lco_branch_heavy_coarse_M0.80.csv    the LCO branch by harmonic balance (1, 2, 3 harmonics), heavy case,
+//   lco_branch_heavy_coarse_M0.80.csv    the LCO branch by harmonic balance (1, 2, 3, 5 harmonics), heavy case,
 //                               coarse grid, M = 0.8 (harmonics,ubar,omega,alpha_amplitude,stable,
 //                               newton_iterations,seconds,steady_seconds); lco_march_heavy_coarse_M0.80.csv
 //                               the BDF2 runs of --lco-march

@@ -429,7 +429,7 @@ inline void verification_part(const options& o, const boundaries& all, std::vect
 // Part 4: centre-manifold reduced model at a transonic Mach number of the heavy case.
 
 /// The LCO branch of the full system by harmonic balance (Newton-Krylov), continued in pitch
-/// amplitude from the Hopf point, landing on 1.001 .. 1.05 Ubar*, for 1, 2 and 3 harmonics;
+/// amplitude from the Hopf point, landing on 1.001 .. 1.05 Ubar*, for 1, 2, 3 and 5 harmonics;
 /// the reduced model beside it. Hill's dense stability is out of reach at this size: a cycle is
 /// marked stable where Ubar grows with the amplitude (exchange of stability with the stable
 /// equilibrium below Ubar*, valid up to the first fold or secondary bifurcation).
@@ -446,7 +446,7 @@ inline void lco_branch_part(const options& o, const aerofoil_system& s, const st
   for (double f : factors) targets.push_back(hp.mu * (1 + side * (f - 1)));
   if (side < 0) std::reverse(targets.begin(), targets.end());
   std::vector<lco_solution> cycles;  // the landed cycles of the last H
-  for (int h : o.quick ? std::vector<int>{1, 2} : std::vector<int>{1, 2, 3}) {
+  for (int h : o.quick ? std::vector<int>{1, 2} : std::vector<int>{1, 2, 3, 5}) {
     hb_krylov<4> kr;
     kr.fill_level = o.fill;
     harmonic_balance_options ho;
