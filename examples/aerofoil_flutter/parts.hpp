@@ -500,7 +500,7 @@ inline void lco_branch_part(const options& o, const aerofoil_system& s, const st
   if (!o.lco_march) return;
   // BDF2 to the limit cycle from inside and outside it: the cycle's state at phase 0 with its
   // displacement from the mean scaled by 0.9 and 1.1, marched for `periods` periods; amplitude
-  // (half peak-to-peak of the pitch) and period over the last three.
+  // (half swing of the pitch) and period over the last three cycles (last_cycles).
   std::cout << "\n  BDF2 (dt = 0.125) to the limit cycle against harmonic balance (H = " << cycles.front().harmonics
             << "):\n";
   // start_scale 0: the amplitude where the envelopes' growth rate vanishes (both runs' samples)
@@ -520,24 +520,13 @@ inline void lco_branch_part(const options& o, const aerofoil_system& s, const st
       const vec<double> w0 = c.mean() + scale * (c.state(0.0) - c.mean());
       const auto mh = march(s, c.mu, w0, periods * c.period(),
                             "lco_" + fixed(c.mu / hp.mu, 3) + "_" + fixed(scale, 1), o);
-      double amax = -INFINITY, amin = INFINITY;
-      std::vector<double> peaks;
-      for (std::size_t k = 1; k + 1 < mh.t.size(); ++k) {
-        if (mh.t[k] > (periods - 3) * c.period()) amax = std::max(amax, mh.alpha[k]), amin = std::min(amin, mh.alpha[k]);
-        if (mh.t[k] > (periods - 6) * c.period() && mh.alpha[k] > mh.alpha[k - 1] && mh.alpha[k] >= mh.alpha[k + 1]) {
-          const double a2 = 0.5 * (mh.alpha[k + 1] - 2 * mh.alpha[k] + mh.alpha[k - 1]);
-          const double a1 = 0.5 * (mh.alpha[k + 1] - mh.alpha[k - 1]);
-          peaks.push_back(mh.t[k] - a1 / (2 * a2) * (mh.t[k + 1] - mh.t[k]));
-        }
-      }
-      const double amp = 0.5 * (amax - amin);
+      const cycle_measure last = last_cycles(mh.t, mh.alpha, 3);
+      const double amp = last.amplitude, om = 2 * std::numbers::pi / last.period;
       for (const auto& e : amplitude_envelope(mh.t, mh.alpha, 1.5 * c.period())) {
         if (!std::isfinite(e.growth_rate)) continue;
         sx += e.amplitude, sy += e.growth_rate, sxx += e.amplitude * e.amplitude, sxy += e.amplitude * e.growth_rate;
         ++ns;
       }
-      const double om = peaks.size() >= 2 ? 2 * std::numbers::pi * double(peaks.size() - 1) / (peaks.back() - peaks.front())
-                                          : NAN;
       mc.row({c.mu, hb_amp, c.omega, scale, amp, om, (long long)periods, mh.seconds});
       std::printf("    Ubar = %.6f (%.3f Ubar*), start %.1f x the cycle: after %d periods amplitude %.6f rad (HB %.6f, %+.2f %%),"
                   " omega %.6f (HB %.6f, %+.3f %%), %.0f s\n",

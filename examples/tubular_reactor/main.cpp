@@ -65,37 +65,6 @@ hopf_result hopf_from_inverse_power(const tubular_reactor& r, double mu0, double
   return solve_hopf(r, hopf_start(r, w0, mu0, omega0), ho);
 }
 
-/// Half peak-to-peak amplitude and mean period of a signal over its last `cycles` cycles.
-struct cycle_measure {
-  double amplitude = 0, period = 0;
-  int cycles = 0;
-};
-cycle_measure measure_cycles(const std::vector<double>& t, const std::vector<double>& y, int cycles) {
-  // local maxima and minima by parabolic refinement
-  std::vector<double> tmax, ymax, ymin;
-  for (size_t k = 1; k + 1 < y.size(); ++k) {
-    if (y[k] > y[k - 1] && y[k] >= y[k + 1]) {
-      const double a = 0.5 * (y[k + 1] - 2 * y[k] + y[k - 1]), b = 0.5 * (y[k + 1] - y[k - 1]);
-      const double s = a != 0 ? -b / (2 * a) : 0;
-      tmax.push_back(t[k] + s * (t[k + 1] - t[k]));
-      ymax.push_back(y[k] - b * b / (4 * a));
-    }
-    if (y[k] < y[k - 1] && y[k] <= y[k + 1]) {
-      const double a = 0.5 * (y[k + 1] - 2 * y[k] + y[k - 1]), b = 0.5 * (y[k + 1] - y[k - 1]);
-      ymin.push_back(y[k] - b * b / (4 * a));
-    }
-  }
-  cycle_measure m;
-  const int c = std::min<int>({cycles, int(ymax.size()) - 1, int(ymin.size())});
-  if (c < 1) return m;
-  double amp = 0;
-  for (int k = 0; k < c; ++k) amp += 0.5 * (ymax[ymax.size() - 1 - k] - ymin[ymin.size() - 1 - k]);
-  m.amplitude = amp / c;
-  m.period = (tmax.back() - tmax[tmax.size() - 1 - c]) / c;
-  m.cycles = c;
-  return m;
-}
-
 struct full_run {
   std::vector<double> t, theta;
   cycle_measure cycle;
@@ -114,7 +83,7 @@ full_run march(const tubular_reactor& r, double mu, const vec<double>& w_start, 
     run.theta.push_back(r.outlet_theta(w));
   });
   run.seconds = seconds_since(t0);
-  run.cycle = measure_cycles(run.t, run.theta, 3);
+  run.cycle = last_cycles(run.t, run.theta, 3);
   return run;
 }
 

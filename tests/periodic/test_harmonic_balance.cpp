@@ -7,6 +7,7 @@
 #include <aerohopf/nonlinear/newton.hpp>
 #include <aerohopf/periodic/harmonic_balance.hpp>
 #include <aerohopf/time/bdf2.hpp>
+#include <aerohopf/time/history.hpp>
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -239,22 +240,9 @@ TEST(HarmonicBalance, TubularReactorCycleMatchesBdf2TimeMarching) {
     t.push_back(si.t);
     y.push_back(ws[r.size() - 1]);
   });
-  // peaks and troughs of the last three periods
-  double ymax = -INFINITY, ymin = INFINITY;
-  std::vector<double> tpk;
-  for (std::size_t k = 1; k + 1 < y.size(); ++k) {
-    if (t[k] < 57 * period) continue;
-    ymax = std::max(ymax, y[k]);
-    ymin = std::min(ymin, y[k]);
-  }
-  for (std::size_t k = 1; k + 1 < y.size(); ++k)
-    if (t[k] > 50 * period && y[k] > y[k - 1] && y[k] >= y[k + 1]) {
-      const double a = 0.5 * (y[k + 1] - 2 * y[k] + y[k - 1]), bb = 0.5 * (y[k + 1] - y[k - 1]);
-      tpk.push_back(t[k] - bb / (2 * a) * dt);
-    }
-  ASSERT_GE(tpk.size(), 5u);
-  const double marched_period = (tpk.back() - tpk.front()) / double(tpk.size() - 1);
-  const double marched_amplitude = 0.5 * (ymax - ymin);
+  const cycle_measure last = last_cycles(t, y, 3);
+  ASSERT_EQ(last.cycles, 3);
+  const double marched_period = last.period, marched_amplitude = last.amplitude;
   const double hb_amplitude = p.probe_amplitude;
   EXPECT_NEAR(marched_amplitude / hb_amplitude, 1.0, 0.01);
   EXPECT_NEAR(marched_period / period, 1.0, 0.005);

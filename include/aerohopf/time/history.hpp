@@ -122,4 +122,31 @@ inline std::vector<amplitude_sample> amplitude_envelope(const std::vector<double
   return r;
 }
 
+/// What a run that has settled on a limit cycle shows over its last cycles (last_cycles).
+struct cycle_measure {
+  double amplitude = NAN;  ///< mean half swing between successive extrema
+  double period = NAN;     ///< mean time between extrema of the same kind
+  int cycles = 0;          ///< cycles used (0: too few extrema)
+};
+
+/// Amplitude and period of an oscillation over its last `cycles` cycles (the limit cycle a
+/// time-marching run has settled on): the 2 cycles half swings between successive refined
+/// extrema of amplitude_envelope, averaged, and the time they span divided by `cycles`. Fewer
+/// extrema than that use what there is; fewer than three give NaN (cycles = 0).
+inline cycle_measure last_cycles(const std::vector<double>& t, const std::vector<double>& y, int cycles) {
+  require(cycles >= 1, "last_cycles: cycles must be >= 1 (got ", cycles, ")");
+  const std::vector<amplitude_sample> e = amplitude_envelope(t, y, t.empty() ? 0.0 : t.front());
+  cycle_measure m;
+  const int c = std::min<int>(cycles, int(e.size()) / 2);
+  if (c < 1) return m;
+  const std::size_t first = e.size() - std::size_t(2 * c);
+  double a = 0;
+  for (std::size_t k = first; k < e.size(); ++k) a += e[k].amplitude;
+  m.amplitude = a / (2 * c);
+  // the samples sit half a period apart: 2c samples span (2c - 1) half periods
+  m.period = 2 * (e.back().t - e[first].t) / (2 * c - 1);
+  m.cycles = c;
+  return m;
+}
+
 }  // namespace aerohopf
