@@ -15,8 +15,10 @@
 // One more row closes the system: mu fixed, a fixed, or the curve stepper's row on x = (W,
 // omega, mu, a) with its metric on (mu, a) only, so that the branch passes folds in mu.
 //
-// Newton with the exact Jacobian, assembled sparse and solved by sparse LU (direct_solver):
-//   dG_j/dw_k = delta_jk A(w_j, mu) - omega D_jk I,   dG_j/domega = -(D W)_j,   dG_j/dmu = f_mu(w_j, mu).
+// Newton with the exact Jacobian
+//   dG_j/dw_k = delta_jk A(w_j, mu) - omega D_jk I,   dG_j/domega = -(D W)_j,   dG_j/dmu = f_mu(w_j, mu),
+// its linear systems solved by a strategy: hb_direct (the default: assembled sparse, sparse LU)
+// or hb_krylov<B> (GMRES with the harmonic preconditioner, for CFD-sized systems; see there).
 // Converged when ||F||_inf <= tolerance for all N n + 3 rows (the state rows are f's units).
 // Failures (convergence_error): no convergence in max_iterations, a non-finite residual, omega
 // leaving (0, inf); the message names the iteration, ||F||_inf, H, omega, mu and a. The input
@@ -30,7 +32,7 @@
 // criterion of Lazarus & Thomas, C. R. Mecanique 338, 2010). The trivial exponent (the phase
 // shift, exactly 0 for the continuous problem: its distance from 0 measures the truncation) is
 // the one nearest 0, and the cycle is stable when every other exponent has Re < 0. Dense: for
-// N n up to hill_max_size.
+// N n up to hill_options::max_size.
 #include <Eigen/Core>
 #include <Eigen/Eigenvalues>
 #include <Eigen/SparseCore>
@@ -489,11 +491,15 @@ struct hb_krylov {
       v.row(2) = c.head(m).transpose();
       corner(1, 2) = -1;
       corner.row(2) = c.tail(3).transpose();
-      auto op = [&](const vec<double>& z, vec<double>& y) {
-        vec<double> ys(m);
-        state_op(z.head(m), ys);
-        y.head(m) = ys + u * z.tail(3);
-        y.tail(3) = v * z.head(m) + corner * z.tail(3);
+      state_in_.resize(m);
+      state_out_.resize(m);
+      auto op = [&](const vec<double>& z, vec<double>& y) {  // allocation-free: member buffers
+        state_in_ = z.head(m);
+        state_op(state_in_, state_out_);
+        y.head(m) = state_out_;
+        y.head(m).noalias() += u * z.tail(3);
+        y.tail(3).noalias() = v * z.head(m);
+        y.tail(3).noalias() += corner * z.tail(3);
       };
       // preconditioner of the state part: Fourier transform, shifted BILU per harmonic, back
       auto state_pre = [&](const vec<double>& r, vec<double>& z) {
@@ -535,7 +541,7 @@ struct hb_krylov {
     const char* who_;
     std::vector<bordered_block_matrix<double, B>> exact_;
     std::vector<bordered_block_ilu<C, B>> ilu_;
-    vec<double> tmp_in_, tmp_out_;
+    vec<double> tmp_in_, tmp_out_, state_in_, state_out_;
     vec<C> rk_, zk_;
     int iterations_ = 0;
   };
