@@ -22,7 +22,7 @@
 //   --verify-grid g             grid of the time-marching verification (default medium)
 //   --contact-smoothing d       contact-switch smoothing of the reduced-model part (default 0.05)
 //   --crossing-medium           the crossing check on the medium grid too (default: coarse and coarser)
-//   --lco-march                 BDF2 runs to the limit cycle at 1.005 and 1.02 Ubar* (from 0.9 and 1.1
+//   --lco-march                 BDF2 runs to the limit cycle at 1.001 .. 1.05 Ubar* (from 0.9 and 1.1
 //                               times the harmonic-balance cycle, 60 periods each) against harmonic balance
 //   --quick                     coarse grid, M = 0.5 .. 0.8 step 0.1, shorter time marching
 //   --verbose                   a line per Hopf Newton iteration
@@ -42,8 +42,9 @@
 //   costs.csv                                                   cost ratios to the steady solve
 //   lco_branch_heavy_coarse_M0.80.csv    the LCO branch by harmonic balance (1, 2, 3, 5 harmonics), heavy case,
 //                               coarse grid, M = 0.8 (harmonics,ubar,omega,alpha_amplitude,stable,
-//                               newton_iterations,seconds,steady_seconds); lco_march_heavy_coarse_M0.80.csv
-//                               the BDF2 runs of --lco-march
+//                               newton_iterations,seconds,steady_seconds); lco_floquet_heavy_coarse_M0.80.csv
+//                               the Floquet exponents nearest 0 at the landed points (Hill, Krylov);
+//                               lco_march_heavy_coarse_M0.80.csv the BDF2 runs of --lco-march
 //   reduced_coefficients.csv, reduced_damping.csv, reduced_lco.csv, reduced_envelope.csv   reduced model
 // plot.py in this folder turns them into PNGs. Exit status 1 if a check fails.
 #include <aerohopf/bifurcation/flutter_boundary.hpp>
@@ -303,11 +304,11 @@ int main(int argc, char** argv) {
     if (o.jump_check) failed_checks += jump_check_part(o, all);
     std::vector<double> march_costs;
     if (o.verify) verification_part(o, all, march_costs);
-    if (o.reduced) reduced_part(o, all);
+    if (o.reduced) failed_checks += reduced_part(o, all);
     cost_part(o, all, march_costs);
     std::cout << "\ntotal " << seconds_since(t0) << " s; results in " << o.out << "\n";
     if (failed_checks > 0) {
-      std::cerr << "aerofoil_flutter: " << failed_checks << " boundary check(s) FAILED\n";
+      std::cerr << "aerofoil_flutter: " << failed_checks << " check(s) FAILED\n";
       return 1;
     }
   } catch (const std::exception& e) {

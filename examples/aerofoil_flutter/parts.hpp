@@ -349,19 +349,19 @@ inline eigenmode_march_result march_pitch_mode(const aerofoil_system& s, double 
   return march_eigenmode(s, ubar, w, ep, mo, solver, history_to(s, tag, o));
 }
 
-/// BDF2 (dt = 0.125, cfd_bdf2_options) of system s at ubar from w0 to t_end: the pitch history.
+/// BDF2 (cfd_bdf2_options, dt = 0.125 unless given) of system s at ubar from w0 to t_end: the pitch history.
 struct march_history {
   std::vector<double> t, alpha;
   double seconds = 0;
 };
 inline march_history march(const aerofoil_system& s, double ubar, const vec<double>& w0, double t_end,
-                           const std::string& tag, const options& o) {
+                           const std::string& tag, const options& o, double dt = 0.125) {
   auto solver = bdf2_inner_solver();
   auto write = history_to(s, tag, o);
   march_history r;
   const auto t0 = clk::now();
   integrate_bdf2(
-      s, ubar, w0, 0.0, t_end, cfd_bdf2_options(0.125),
+      s, ubar, w0, 0.0, t_end, cfd_bdf2_options(dt),
       [&](const bdf2_step_info& i, const vec<double>& w) {
         r.t.push_back(i.t);
         r.alpha.push_back(w[write.ia]);
@@ -430,22 +430,29 @@ inline void verification_part(const options& o, const boundaries& all, std::vect
 
 /// The LCO branch of the full system by harmonic balance (Newton-Krylov), continued in pitch
 /// amplitude from the Hopf point, landing on 1.001 .. 1.05 Ubar*, for 1, 2, 3 and 5 harmonics;
-/// the reduced model beside it. Hill's dense stability is out of reach at this size: a cycle is
+/// the reduced model beside it. Stability: Floquet exponents nearest 0 by Hill's method with
+/// shift-invert Arnoldi (hill_floquet_krylov) at the landed points; between them a cycle is
 /// marked stable where Ubar grows with the amplitude (exchange of stability with the stable
-/// equilibrium below Ubar*, valid up to the first fold or secondary bifurcation).
-inline void lco_branch_part(const options& o, const aerofoil_system& s, const steady_result& st, const hopf_point& hp,
-                            const centre_manifold_model& model, Eigen::Index ia, double side) {
+/// equilibrium below Ubar*), which the landed points check.
+/// Returns the number of landed points where the two stability verdicts disagree.
+inline int lco_branch_part(const options& o, const aerofoil_system& s, const steady_result& st, const hopf_point& hp,
+                           const centre_manifold_model& model, Eigen::Index ia, double side) {
   std::cout << "\n  LCO branch by harmonic balance (Newton-Krylov, BILU(" << o.fill
             << ") per harmonic), pitch amplitude against Ubar:\n";
   const vec<double> probe = vec<double>::Unit(s.size(), ia);
   const std::string name = "lco_branch_heavy_coarse_M0.80.csv";
   csv_writer lc(o.out / name, "harmonics,ubar,omega,alpha_amplitude,stable,newton_iterations,seconds,steady_seconds");
+  csv_writer fc(o.out / "lco_floquet_heavy_coarse_M0.80.csv",
+                "harmonics,ubar,alpha_amplitude,trivial_exponent,radial_exponent,radius,stable,linear_solves,"
+                "linear_iterations,seconds,steady_seconds");
   std::vector<double> factors = {1.001, 1.002, 1.005, 1.01, 1.02, 1.05};
   if (o.quick) factors = {1.002, 1.01};
   std::vector<double> targets;
   for (double f : factors) targets.push_back(hp.mu * (1 + side * (f - 1)));
   if (side < 0) std::reverse(targets.begin(), targets.end());
   std::vector<lco_solution> cycles;  // the landed cycles of the last H
+  std::vector<double> exponents;     // and their radial Floquet exponents
+  int disagreements = 0;
   for (int h : o.quick ? std::vector<int>{1, 2} : std::vector<int>{1, 2, 3, 5}) {
     hb_krylov<4> kr;
     kr.fill_level = o.fill;
@@ -467,82 +474,98 @@ inline void lco_branch_part(const options& o, const aerofoil_system& s, const st
     bo.mu_max = hp.mu * 1.06;
     bo.amplitude_max = 0.2;
     bo.max_points = 80;
-    bo.stability = false;
+    bo.stability = false;  // Hill's dense matrix is out of reach: the Krylov form at the landed points
     std::optional<double> last_mu;
     int landed = 0;
     cycles.clear();
+    exponents.clear();
     const lco_branch b = trace_lco_branch(
         s, start, probe, bo,
         [&](const lco_branch_point& p) {
-          const bool stable = last_mu ? side * (p.cycle.mu - *last_mu) > 0 : true;
+          bool stable = last_mu ? side * (p.cycle.mu - *last_mu) > 0 : true;
           last_mu = p.cycle.mu;
-          lc.row({(long long)h, p.cycle.mu, p.cycle.omega, p.probe_amplitude, (long long)stable,
-                  (long long)p.cycle.newton_iterations, p.cycle.seconds, st.seconds});
           if (p.landed) {
             ++landed;
             cycles.push_back(p.cycle);
+            hill_krylov_options fo;
+            fo.fill_level = o.fill;
+            const auto tf = clk::now();
+            const floquet_result f = hill_floquet_krylov<4>(s, p.cycle, fo);
+            const double fs = seconds_since(tf);
+            exponents.push_back(f.max_real);
+            if (f.stable != stable) ++disagreements;
+            stable = f.stable;
+            fc.row({(long long)h, p.cycle.mu, p.probe_amplitude, f.trivial.real(), f.max_real, f.radius,
+                    (long long)f.stable, (long long)f.linear_solves, (long long)f.linear_iterations, fs, st.seconds});
             const double dmu = p.cycle.mu - hp.mu;
             const auto l = model.lco(dmu);
             const double reduced = l.exists ? model.component_amplitude(ia, dmu).first : NAN;
             std::printf("    H = %d  Ubar = %.6f (%.3f Ubar*)  pitch amplitude %.6f rad (reduced model %.6f, %+.1f %%)  "
-                        "omega %.6f (Hopf %.6f)  Newton %d, GMRES %d  %.1f s = %.2f steady solves\n",
+                        "omega %.6f (Hopf %.6f)  Newton %d, GMRES %d  %.1f s = %.2f steady solves; %.1f MB per instance\n"
+                        "           Floquet (Hill, Krylov): radial exponent %+.4e (trivial %+.1e) %s, %d GMRES solves"
+                        " (%d iterations) %.1f s = %.1f steady solves\n",
                         h, p.cycle.mu, p.cycle.mu / hp.mu, p.probe_amplitude, reduced,
                         100 * (reduced / p.probe_amplitude - 1), p.cycle.omega, hp.omega, p.cycle.newton_iterations,
-                        p.cycle.linear_iterations, p.cycle.seconds, p.cycle.seconds / st.seconds);
+                        p.cycle.linear_iterations, p.cycle.seconds, p.cycle.seconds / st.seconds,
+                        double(p.cycle.linear_bytes) / p.cycle.instance_count() / 1e6, f.max_real, f.trivial.real(),
+                        f.stable ? "stable" : "UNSTABLE", f.linear_solves, f.linear_iterations, fs, fs / st.seconds);
           }
+          lc.row({(long long)h, p.cycle.mu, p.cycle.omega, p.probe_amplitude, (long long)stable,
+                  (long long)p.cycle.newton_iterations, p.cycle.seconds, st.seconds});
           return landed == int(targets.size());
         },
         kr);
     std::printf("    H = %d: %zu points, %d landed, %.1f s in all (%s)\n", h, b.points.size(), landed, seconds_since(t0),
                 b.stop_reason.empty() ? "all targets landed" : b.stop_reason.c_str());
   }
-  std::printf("    one steady solve: %.2f s; wrote %s\n", st.seconds, name.c_str());
-  if (!o.lco_march) return;
+  std::printf("    one steady solve: %.2f s; wrote %s and lco_floquet_heavy_coarse_M0.80.csv\n", st.seconds, name.c_str());
+  if (disagreements > 0)
+    std::printf("    FAILED: at %d landed points Hill's Floquet exponents and the branch direction disagree on stability\n",
+                disagreements);
+  if (!o.lco_march) return disagreements;
   // BDF2 to the limit cycle from inside and outside it: the cycle's state at phase 0 with its
   // displacement from the mean scaled by 0.9 and 1.1, marched for `periods` periods; amplitude
-  // (half swing of the pitch) and period over the last three cycles (last_cycles).
-  std::cout << "\n  BDF2 (dt = 0.125) to the limit cycle against harmonic balance (H = " << cycles.front().harmonics
-            << "):\n";
-  // start_scale 0: the amplitude where the envelopes' growth rate vanishes (both runs' samples)
+  // (half swing of the pitch) and period over the last three cycles (last_cycles), and the cycle
+  // both runs approach (limit_cycle_from_envelopes). dt = 0.125 (210 steps per period) damps
+  // the oscillation by O((omega dt)^4) per step, about 1e-6 per unit time: 4 % of the growth
+  // rate at 1.001 Ubar*, so dt is halved below 1.003 Ubar*.
+  std::cout << "\n  BDF2 to the limit cycle against harmonic balance (H = " << cycles.front().harmonics << "):\n";
+  // start_scale 0: the cycle where the envelopes' growth rate vanishes (both runs' samples)
   csv_writer mc(o.out / "lco_march_heavy_coarse_M0.80.csv",
-                "ubar,hb_amplitude,hb_omega,start_scale,march_amplitude,march_omega,periods,seconds");
+                "ubar,hb_amplitude,hb_omega,hb_exponent,start_scale,march_amplitude,march_omega,march_exponent,periods,"
+                "dt,seconds");
   const int periods = o.quick ? 20 : 60;
-  for (const lco_solution& c : cycles) {
-    if (o.quick ? std::abs(c.mu / hp.mu - 1 - side * 0.01) > 1e-9
-                : std::abs(c.mu / hp.mu - 1 - side * 0.005) > 1e-9 && std::abs(c.mu / hp.mu - 1 - side * 0.02) > 1e-9)
-      continue;
+  for (std::size_t q = 0; q < cycles.size(); ++q) {
+    const lco_solution& c = cycles[q];
+    if (o.quick && std::abs(c.mu / hp.mu - 1 - side * 0.01) > 1e-9) continue;
     const double hb_amp = probe_peak_amplitude(c, probe);
-    // the envelopes' growth rate sigma(A) of both runs, a line through all samples: its zero is
-    // the marched cycle's amplitude (interpolated: the runs approach it from both sides)
-    double sx = 0, sy = 0, sxx = 0, sxy = 0;
-    int ns = 0;
+    const double dt = std::abs(c.mu / hp.mu - 1) < 0.003 ? 0.0625 : 0.125;
+    std::vector<std::vector<amplitude_sample>> envelopes;
     for (double scale : {0.9, 1.1}) {
       const vec<double> w0 = c.mean() + scale * (c.state(0.0) - c.mean());
       const auto mh = march(s, c.mu, w0, periods * c.period(),
-                            "lco_" + fixed(c.mu / hp.mu, 3) + "_" + fixed(scale, 1), o);
+                            "lco_" + fixed(c.mu / hp.mu, 3) + "_" + fixed(scale, 1), o, dt);
       const cycle_measure last = last_cycles(mh.t, mh.alpha, 3);
       const double amp = last.amplitude, om = 2 * std::numbers::pi / last.period;
-      for (const auto& e : amplitude_envelope(mh.t, mh.alpha, 1.5 * c.period())) {
-        if (!std::isfinite(e.growth_rate)) continue;
-        sx += e.amplitude, sy += e.growth_rate, sxx += e.amplitude * e.amplitude, sxy += e.amplitude * e.growth_rate;
-        ++ns;
-      }
-      mc.row({c.mu, hb_amp, c.omega, scale, amp, om, (long long)periods, mh.seconds});
+      envelopes.push_back(amplitude_envelope(mh.t, mh.alpha, 1.5 * c.period()));
+      mc.row({c.mu, hb_amp, c.omega, exponents[q], scale, amp, om, NAN, (long long)periods, dt, mh.seconds});
       std::printf("    Ubar = %.6f (%.3f Ubar*), start %.1f x the cycle: after %d periods amplitude %.6f rad (HB %.6f, %+.2f %%),"
-                  " omega %.6f (HB %.6f, %+.3f %%), %.0f s\n",
+                  " omega %.6f (HB %.6f, %+.3f %%), dt %.4f, %.0f s\n",
                   c.mu, c.mu / hp.mu, scale, periods, amp, hb_amp, 100 * (amp / hb_amp - 1), om, c.omega,
-                  100 * (om / c.omega - 1), mh.seconds);
+                  100 * (om / c.omega - 1), dt, mh.seconds);
     }
-    const double s1 = (ns * sxy - sx * sy) / (ns * sxx - sx * sx), s0 = (sy - s1 * sx) / ns;
-    const double a_lc = -s0 / s1;
-    mc.row({c.mu, hb_amp, c.omega, 0.0, a_lc, NAN, (long long)periods, 0.0});
-    std::printf("    Ubar = %.6f: the envelopes' growth rate vanishes at amplitude %.6f rad (HB %.6f, %+.2f %%; %d samples,"
-                " d sigma / dA = %.4f)\n",
-                c.mu, a_lc, hb_amp, 100 * (a_lc / hb_amp - 1), ns, s1);
+    const envelope_cycle e = limit_cycle_from_envelopes(envelopes);
+    mc.row({c.mu, hb_amp, c.omega, exponents[q], 0.0, e.amplitude, NAN, e.exponent, (long long)periods, dt, 0.0});
+    std::printf("    Ubar = %.6f: the envelopes' growth rate vanishes at amplitude %.6f rad (HB %.6f, %+.2f %%; %d samples%s);"
+                " radial exponent %+.4e (Hill %+.4e, %+.1f %%)\n",
+                c.mu, e.amplitude, hb_amp, 100 * (e.amplitude / hb_amp - 1), e.samples,
+                e.bracketed ? "" : ", NOT bracketed", e.exponent, exponents[q], 100 * (e.exponent / exponents[q] - 1));
   }
+  return disagreements;
 }
 
-inline void reduced_part(const options& o, const boundaries& all) {
+/// Returns the number of failed checks (lco_branch_part).
+inline int reduced_part(const options& o, const boundaries& all) {
   const structural_case& c = heavy_case;
   const grid_level g = level_named("coarse");
   const double mach = 0.8;  // transonic: shocks on both surfaces at zero incidence
@@ -647,8 +670,8 @@ inline void reduced_part(const options& o, const boundaries& all) {
     std::printf("  LCO at Ubar = %.5f: pitch amplitude %.5f rad, frequency %.5f, %s\n", hp.mu + dmu, amp, l.frequency,
                 l.stable ? "stable" : "unstable");
   }
-  lco_branch_part(o, s, st, hp, model, ia, side);
-  if (!o.verify) return;
+  const int failed = lco_branch_part(o, s, st, hp, model, ia, side);
+  if (!o.verify) return failed;
 
   // Verification of the nonlinear term by time marching: the amplitude-dependent growth rate.
   // On the centre manifold |z|' = |z| (Re(a) dmu + Re(c1) |z|^2), and the pitch amplitude is
@@ -715,6 +738,7 @@ inline void reduced_part(const options& o, const boundaries& all) {
                 "growth at zero amplitude %+.4e vs %+.4e\n",
                 ubar, ubar / hp.mu, a_march, a_pred, 100 * (a_march / a_pred - 1), s0, re_a * dmu);
   }
+  return failed;
 }
 
 

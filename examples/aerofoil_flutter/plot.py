@@ -218,7 +218,8 @@ def reduced(out):
 
 def lco_branch(out):
     """Pitch LCO amplitude against Ubar / Ubar*: harmonic balance per H (solid where marked
-    stable), the reduced model and the BDF2 runs to the cycle (--lco-march)."""
+    stable), the reduced model and the BDF2 runs to the cycle (--lco-march); the cycles' radial
+    Floquet exponent (lco_floquet.png)."""
     path = os.path.join(out, "lco_branch_heavy_coarse_M0.80.csv")
     if not os.path.exists(path):
         return
@@ -251,6 +252,24 @@ def lco_branch(out):
     finish_axes(ax, "$\\bar U / \\bar U^*$ (first point of the H = 1 branch)", "pitch LCO amplitude (rad)",
                 "heavy case, coarse grid, M = 0.8 (solid: stable, dotted: unstable)")
     save(fig, out, "lco_branch.png")
+    fpath = os.path.join(out, "lco_floquet_heavy_coarse_M0.80.csv")
+    if os.path.exists(fpath):
+        # the radial Floquet exponent of the cycles: Hill (Krylov) per H, BDF2 envelopes' slope
+        f = read(fpath)
+        fig, ax = plt.subplots(figsize=(7.5, 4.5))
+        for h in sorted({int(r["harmonics"]) for r in f}):
+            pts = [r for r in f if int(r["harmonics"]) == h]
+            ax.plot([float(r["ubar"]) / ubar_star for r in pts], col(pts, "radial_exponent"), "o-",
+                    color=colours.get(h, "gray"), label=f"Hill's method (Krylov), H = {h}")
+        if os.path.exists(mpath):
+            fits = [r for r in read(mpath) if float(r["start_scale"]) == 0]
+            if fits:
+                ax.plot([float(r["ubar"]) / ubar_star for r in fits], col(fits, "march_exponent"), "k*", ms=10,
+                        label="BDF2: amplitude x slope of the envelopes' growth rate")
+        ax.axhline(0, color="gray", lw=0.5)
+        finish_axes(ax, "$\\bar U / \\bar U^*$", "radial Floquet exponent",
+                    "stability of the LCO (negative: stable)")
+        save(fig, out, "lco_floquet.png")
 
 
 def main():

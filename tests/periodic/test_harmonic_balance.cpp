@@ -59,6 +59,50 @@ struct van_der_pol {
   }
 };
 
+/// A system viewed with an Eigen sparse Jacobian (the Krylov path's bordered form of B = 2).
+template <class S>
+struct sparse_view {
+  using jacobian_type = Eigen::SparseMatrix<double>;
+  const S& s;
+  Eigen::Index size() const { return s.size(); }
+  template <class T>
+  vec<T> residual(const vec<T>& w, const T& mu) const {
+    return s.residual(w, mu);
+  }
+  jacobian_type jacobian(const vec<double>& w, double mu) const { return s.jacobian(w, mu).sparseView(); }
+};
+
+/// sparse_view with an approximate (preconditioning) Jacobian that drops the entries below 0.3 in
+/// magnitude: its pattern changes along a cycle (the mean over the instances takes the union).
+template <class S>
+struct pruned_preconditioner_view : sparse_view<S> {
+  Eigen::SparseMatrix<double> approximate_jacobian(const vec<double>& w, double mu) const {
+    return Eigen::MatrixXd(this->s.jacobian(w, mu)).sparseView(1.0, 0.3);
+  }
+};
+
+/// Every exponent of the Krylov result is one of the dense result's, and every dense exponent
+/// within the Krylov radius of its shift is found.
+void expect_krylov_matches_dense(const floquet_result& k, const floquet_result& d, double tol) {
+  EXPECT_FALSE(k.complete);
+  EXPECT_TRUE(d.complete);
+  ASSERT_FALSE(k.exponents.empty());
+  for (const auto& x : k.exponents) {
+    double best = INFINITY;
+    for (const auto& y : d.exponents) best = std::min(best, std::abs(x - y));
+    EXPECT_LT(best, tol) << "Krylov exponent " << x << " is not a dense one";
+  }
+  for (const auto& y : d.exponents) {
+    if (std::abs(y - k.shift) > 0.999 * k.radius) continue;
+    double best = INFINITY;
+    for (const auto& x : k.exponents) best = std::min(best, std::abs(x - y));
+    EXPECT_LT(best, tol) << "dense exponent " << y << " within the radius " << k.radius << " missed";
+  }
+  EXPECT_NEAR(k.trivial.real(), d.trivial.real(), tol);
+  EXPECT_NEAR(k.max_real, d.max_real, tol);
+  EXPECT_EQ(k.stable, d.stable);
+}
+
 }  // namespace
 
 TEST(HarmonicBalance, DifferentiationMatrixIsExactOnTrigonometricPolynomials) {
@@ -302,6 +346,61 @@ TEST(HarmonicBalance, KrylovStrategyEqualsSparseLuOnTheAerofoil) {
   EXPECT_NEAR(krylov.omega, direct.omega, 1e-8 * direct.omega);
   EXPECT_LT((krylov.instances - direct.instances).cwiseAbs().maxCoeff(), 1e-7);
   EXPECT_NE(krylov.mu, h.point.mu);  // a finite cycle: off the Hopf point
+}
+
+TEST(HarmonicBalance, KrylovHillExponentsEqualTheDenseOnesAndTheClosedForms) {
+  {  // supercritical circle with stable extra directions: 0, -2 r^2, -d_k
+    const polar_normal_form base(-1.0, 0.0, 0.3);
+    const sparse_view<polar_normal_form> s{base};
+    const vec<double> e = base.probe_x1();
+    const lco_solution c = solve_lco(s, lco_guess_from_hopf(origin_hopf(base), e, 0.1, 3), e, lco_fix::amplitude, 0.3);
+    hill_krylov_options ho;
+    ho.exponents = 3;  // 0, -0.18 and -1 (after the copies of the first two at +-i omega)
+    ho.subspace = 24;
+    const floquet_result k = hill_floquet_krylov<2>(s, c, ho);
+    expect_krylov_matches_dense(k, hill_floquet(s, c), 1e-8);
+    EXPECT_NEAR(k.max_real, -0.18, 1e-9);
+    EXPECT_LT(std::abs(k.trivial), 1e-9);
+    EXPECT_TRUE(k.stable);
+    // a preconditioning matrix whose pattern differs between the instances: the same exponents
+    const pruned_preconditioner_view<polar_normal_form> sp{{base}};
+    const floquet_result kp = hill_floquet_krylov<2>(sp, c, ho);
+    EXPECT_NEAR(kp.max_real, -0.18, 1e-9);
+    EXPECT_NE(kp.linear_iterations, k.linear_iterations);  // another preconditioner
+  }
+  {  // subcritical circle: unstable, the radial exponent 2 c3 r^2 = +0.08
+    const polar_normal_form base(1.0, 0.0, -0.2);
+    const sparse_view<polar_normal_form> s{base};
+    const vec<double> e = base.probe_x1();
+    const lco_solution c = solve_lco(s, lco_guess_from_hopf(origin_hopf(base), e, 0.2, 3), e, lco_fix::parameter, -0.04);
+    const floquet_result k = hill_floquet_krylov<2>(s, c);
+    EXPECT_NEAR(k.max_real, 0.08, 1e-9);
+    EXPECT_FALSE(k.stable);
+    expect_krylov_matches_dense(k, hill_floquet(s, c), 1e-8);
+  }
+  {  // the reactor's cycle (16 cells, 4 harmonics, pitch of the Krylov path B = 2)
+    const tubular_reactor r(16);
+    const hopf_point hp = reactor_hopf(r);
+    const vec<double> e = vec<double>::Unit(r.size(), r.size() - 1);
+    const lco_solution c = solve_lco(r, lco_guess_from_hopf(hp, e, 0.01, 4), e, lco_fix::amplitude);
+    for (auto pre : {hb_preconditioner_state::mean_state, hb_preconditioner_state::mean_jacobian}) {
+      hill_krylov_options ho;
+      ho.preconditioner = pre;
+      const floquet_result k = hill_floquet_krylov<2>(r, c, ho);
+      const floquet_result d = hill_floquet(r, c);
+      expect_krylov_matches_dense(k, d, 1e-7);
+      EXPECT_TRUE(k.stable);
+      EXPECT_GE(k.exponents.size(), 2u);
+    }
+    // the options are checked
+    hill_krylov_options bad;
+    bad.subspace = bad.exponents + 2;
+    EXPECT_THROW(hill_floquet_krylov<2>(r, c, bad), input_error);
+    bad = {};
+    bad.max_iterations = 1;
+    const std::string msg = test::error_of<convergence_error>([&] { hill_floquet_krylov<2>(r, c, bad); });
+    EXPECT_TRUE(test::contains(msg, "GMRES on Hill's matrix")) << msg;
+  }
 }
 
 TEST(HarmonicBalance, BadInputIsRefusedAndNonConvergenceIsReported) {

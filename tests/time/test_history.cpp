@@ -31,3 +31,36 @@ TEST(last_cycles, amplitude_and_period_of_a_settled_cosine) {
   EXPECT_THROW(last_cycles(t, y, 0), input_error);
   EXPECT_THROW(last_cycles({0.0, 1.0}, {1.0}, 1), input_error);
 }
+
+TEST(limit_cycle_from_envelopes, landau_cycle_amplitude_and_radial_exponent_from_both_sides) {
+  // y = A(t) cos(omega t) with dA/dt = alpha A - beta A^3 (closed form): the stable cycle
+  // A* = sqrt(alpha / beta), its radial exponent -2 alpha; runs from 0.9 and 1.1 A*, 10 periods
+  const double alpha = 0.02, beta = 50.0, omega = 1.0, as = std::sqrt(alpha / beta), dt = 2 * std::numbers::pi / 80;
+  std::vector<std::vector<amplitude_sample>> runs;
+  for (double start : {0.9, 1.1}) {
+    std::vector<double> t, y;
+    const double a0 = start * as;
+    for (int k = 0; k <= 80 * 10; ++k) {
+      const double tk = k * dt;
+      const double a = as / std::sqrt(1 + (as * as / (a0 * a0) - 1) * std::exp(-2 * alpha * tk));
+      t.push_back(tk);
+      y.push_back(a * std::cos(omega * tk));
+    }
+    runs.push_back(amplitude_envelope(t, y, 0.0));
+  }
+  const envelope_cycle c = limit_cycle_from_envelopes(runs);
+  EXPECT_NEAR(c.amplitude / as, 1.0, 2e-3);
+  EXPECT_NEAR(c.exponent / (-2 * alpha), 1.0, 0.03);
+  EXPECT_TRUE(c.bracketed);
+  EXPECT_GT(c.samples, 30);
+  // an unstable cycle (alpha, beta < 0: runs leave it) has a positive exponent
+  for (auto& run : runs)
+    for (auto& e : run) e.growth_rate = -e.growth_rate;
+  const envelope_cycle u = limit_cycle_from_envelopes(runs);
+  EXPECT_NEAR(u.amplitude / as, 1.0, 2e-3);
+  EXPECT_GT(u.exponent, 0.0);
+  // too little to fit, or nothing that changes
+  EXPECT_THROW(limit_cycle_from_envelopes({}), input_error);
+  EXPECT_THROW(limit_cycle_from_envelopes({{{0.0, 1.0, 0.1}, {1.0, 1.0, 0.2}, {2.0, 1.0, 0.3}}}), input_error);
+  EXPECT_THROW(limit_cycle_from_envelopes({{{0.0, 1.0, 0.1}, {1.0, 2.0, 0.1}, {2.0, 3.0, 0.1}}}), convergence_error);
+}

@@ -84,6 +84,7 @@ struct lco_solution {
   int linear_iterations = 0;   ///< Krylov iterations of the solve (0 for the direct strategy)
   double residual = 0;         ///< ||F||_inf at the solution
   double seconds = 0;          ///< wall time of the solve
+  std::size_t linear_bytes = 0;  ///< memory of the Krylov strategy's matrices, factors and basis (0: direct)
 
   int instance_count() const { return 2 * harmonics + 1; }
   Eigen::Index state_size() const { return instances.rows(); }
@@ -343,6 +344,7 @@ struct hb_newton_outcome {
   int iterations = 0;
   int linear_iterations = 0;
   double residual = 0;
+  std::size_t linear_bytes = 0;
 };
 
 /// Newton on (F(x), c.x - value) = 0 from x0 with the linear solver `lin` (lin(x, c, rhs) =
@@ -364,7 +366,7 @@ hb_newton_outcome hb_newton(const harmonic_balance_equations<S>& eq, vec<double>
     if (o.log) *o.log << o.label << ": iteration " << it << "  ||F||_inf " << fn << "  omega " << x[eq.omega_index()]
                       << "  mu " << x[eq.mu_index()] << "  a " << x[eq.amplitude_index()] << "\n";
     if (!std::isfinite(fn)) throw convergence_error(describe(it, fn) + ": the residual is not finite");
-    if (fn <= o.tolerance) return {std::move(x), it, lin.iterations() - linear_before, fn};
+    if (fn <= o.tolerance) return {std::move(x), it, lin.iterations() - linear_before, fn, lin.bytes()};
     if (it >= o.max_iterations)
       throw convergence_error(describe(it, fn) + concat(": not converged to ", o.tolerance, " in ", o.max_iterations,
                                                         " iterations"));
@@ -413,6 +415,7 @@ struct hb_direct {
       return lu.solve(rhs);
     }
     int iterations() const { return 0; }
+    std::size_t bytes() const { return 0; }
   };
   template <dynamical_system S>
   solver<S> make(const internal::harmonic_balance_equations<S>& eq, const S&, const char*) const {
@@ -420,15 +423,148 @@ struct hb_direct {
   }
 };
 
+/// The matrix P of the harmonic preconditioner (hb_krylov, hill_floquet_krylov): the
+/// preconditioning matrix at the cycle's mean state, or the mean of the instances' preconditioning
+/// matrices (the zeroth Fourier coefficient of P(w(tau)): the harmonic-space block diagonal of the
+/// Jacobian, which keeps a travelling shock smeared over its excursion instead of sharp at its
+/// mean position; it costs N preconditioning assemblies instead of one).
+enum class hb_preconditioner_state { mean_state, mean_jacobian };
+
+namespace internal {
+
+/// Hill's operator with a real shift, blockdiag(A(w_j)) - omega D (x) I - sigma I on N n
+/// unknowns, by the exact bordered Jacobians of the instances, and its harmonic preconditioner:
+/// the exact inverse of blockdiag(P) - omega D (x) I - sigma I, by a discrete Fourier transform
+/// over the instances to P - (sigma + i k omega) I for harmonics k = 0 .. H, each by a complex
+/// bordered BILU(k). The BILUs keep their symbolic phase from one build to the next.
+template <int B, dynamical_system S>
+class hill_operator {
+ public:
+  using C = std::complex<double>;
+
+  void build(const S& sys, const Eigen::Ref<const Eigen::MatrixXd>& w, double mu, double omega, double sigma,
+             const Eigen::MatrixXd& d, int fill_level, hb_preconditioner_state state, const char* who) {
+    n_ = w.rows();
+    nn_ = int(w.cols());
+    h_ = (nn_ - 1) / 2;
+    omega_ = omega;
+    sigma_ = sigma;
+    d_ = &d;
+    exact_.clear();
+    std::optional<bordered_block_matrix<double, B>> p;
+    if (state == hb_preconditioner_state::mean_jacobian) {
+      typename bordered_block_matrix<double, B>::flow_matrix ff;
+      typename bordered_block_matrix<double, B>::dense_matrix fs, sf, ss;
+      for (int j = 0; j < nn_; ++j) {
+        auto pair = krylov_jacobians<B>(sys, vec<double>(w.col(j)), mu, who);
+        exact_.push_back(std::move(pair.exact));
+        const auto& pj = pair.preconditioning;
+        if (j == 0) {
+          ff = pj.flow();
+          fs = pj.flow_structure();
+          sf = pj.structure_flow();
+          ss = pj.structure();
+          continue;
+        }
+        if (pj.flow().row_ptr() == ff.row_ptr() && pj.flow().col_index() == ff.col_index()) {
+          auto& v = ff.values();
+          for (std::size_t q = 0; q < v.size(); ++q) v[q] += pj.flow().values()[q];
+        } else {  // patterns differ (entries that vanish at some instances): the union
+          const Eigen::SparseMatrix<double> sum = ff.to_sparse() + pj.flow().to_sparse();
+          ff = bordered_block_matrix<double, B>::flow_matrix::from_sparse(sum, B);
+        }
+        fs += pj.flow_structure();
+        sf += pj.structure_flow();
+        ss += pj.structure();
+      }
+      for (double& v : ff.values()) v /= nn_;
+      p.emplace(std::move(ff), fs / nn_, sf / nn_, ss / nn_, who);
+    } else {
+      for (int j = 0; j < nn_; ++j) exact_.push_back(krylov_exact_jacobian<B>(sys, vec<double>(w.col(j)), mu, who));
+      p.emplace(krylov_jacobians<B>(sys, vec<double>(w.rowwise().mean()), mu, who).preconditioning);
+    }
+    if (int(ilu_.size()) != h_ + 1 || fill_level != fill_level_) {
+      ilu_.clear();
+      for (int k = 0; k <= h_; ++k) {
+        block_ilu_options bo;
+        bo.fill_level = fill_level;
+        bo.context = concat(who, ": BILU(", fill_level, ") of P - (sigma + i ", k, " omega) I");
+        ilu_.emplace_back(bo);
+      }
+      fill_level_ = fill_level;
+    }
+    for (int k = 0; k <= h_; ++k) ilu_[std::size_t(k)].compute(*p, C(sigma, k * omega));
+    tw_.resize(nn_, h_ + 1);
+    for (int j = 0; j < nn_; ++j)
+      for (int k = 0; k <= h_; ++k) tw_(j, k) = std::polar(1.0, 2 * std::numbers::pi * k * j / nn_);
+  }
+  Eigen::Index rows() const { return nn_ * n_; }
+
+  /// y = (Hill - sigma I) v, v and y of N n entries.
+  void apply(const vec<double>& v, vec<double>& y) {
+    const Eigen::Map<const Eigen::MatrixXd> vm(v.data(), n_, nn_);
+    Eigen::Map<Eigen::MatrixXd> ym(y.data(), n_, nn_);
+    ym.noalias() = -omega_ * (vm * d_->transpose());
+    if (sigma_ != 0) ym -= sigma_ * vm;
+    for (int j = 0; j < nn_; ++j) {
+      in_ = vm.col(j);
+      out_.resize(n_);
+      exact_[std::size_t(j)].apply(in_, out_);
+      ym.col(j) += out_;
+    }
+  }
+  /// z = M^{-1} r (the harmonic preconditioner), r and z of N n entries.
+  void precondition(const vec<double>& r, vec<double>& z) {
+    const Eigen::Map<const Eigen::MatrixXd> rm(r.data(), n_, nn_);
+    Eigen::Map<Eigen::MatrixXd> zm(z.data(), n_, nn_);
+    zm.setZero();
+    for (int k = 0; k <= h_; ++k) {
+      rk_ = vec<C>::Zero(n_);
+      for (int j = 0; j < nn_; ++j) rk_ += rm.col(j).cast<C>() * (std::conj(tw_(j, k)) / double(nn_));
+      zk_.resize(n_);
+      ilu_[std::size_t(k)].apply(rk_, zk_);
+      for (int j = 0; j < nn_; ++j) zm.col(j) += (k == 0 ? 1.0 : 2.0) * (zk_ * tw_(j, k)).real();
+    }
+  }
+  /// Bytes held: the instances' exact Jacobians and the per-harmonic factors.
+  std::size_t bytes() const {
+    std::size_t b = 0;
+    for (const auto& a : exact_) {
+      b += a.flow().values().size() * sizeof(double) +
+           (a.flow().col_index().size() + a.flow().row_ptr().size()) * sizeof(int);
+      b += std::size_t(a.flow_structure().size() + a.structure_flow().size() + a.structure().size()) * sizeof(double);
+    }
+    for (const auto& f : ilu_) {
+      const auto& l = f.flow_preconditioner();
+      b += l.factor_col_index().size() * (std::size_t(B * B) * sizeof(C) + 2 * sizeof(int)) +
+           l.factor_row_ptr().size() * sizeof(int);
+      b += std::size_t(2 * f.structure_size()) * std::size_t(n_) * sizeof(C);
+    }
+    return b;
+  }
+
+ private:
+  Eigen::Index n_ = 0;
+  int nn_ = 0, h_ = 0, fill_level_ = -1;
+  double omega_ = 0, sigma_ = 0;
+  const Eigen::MatrixXd* d_ = nullptr;
+  std::vector<bordered_block_matrix<double, B>> exact_;
+  std::vector<bordered_block_ilu<C, B>> ilu_;
+  Eigen::MatrixXcd tw_;
+  vec<double> in_, out_;
+  vec<C> rk_, zk_;
+};
+
+}  // namespace internal
+
 /// The linear solver by GMRES with the harmonic preconditioner, for CFD-sized systems: the exact
 /// Jacobians A(w_j) of every instance in bordered block form (krylov_exact_jacobian<B>, flow
 /// blocks of B plus the structural border), and as preconditioner the exact inverse of
-/// blockdiag(P) - omega D (x) I with P the preconditioning (e.g. modified-order) matrix at the
-/// cycle's mean state: by a discrete Fourier transform over the instances it is P - i k omega I
-/// for harmonic k = 0 .. H, each by a complex bordered BILU(k) (the shifted solves of the Hopf
-/// path), and the three border unknowns (omega, mu, a) with their rows are eliminated exactly
-/// around it (a 3 x 3 Schur complement). Near onset the cycle's instances differ little from
-/// their mean, so GMRES needs few iterations; they grow with the amplitude.
+/// blockdiag(P) - omega D (x) I (internal::hill_operator: per harmonic k a complex bordered
+/// BILU(k) of P - i k omega I, the shifted solves of the Hopf path), P by hb_preconditioner_state;
+/// the three border unknowns (omega, mu, a) with their rows are eliminated exactly around it (a
+/// 3 x 3 Schur complement). Near onset the instances differ little from their mean and GMRES
+/// needs few iterations; they grow with the amplitude.
 template <int B>
 struct hb_krylov {
   int fill_level = 1;                  ///< k of each BILU(k)
@@ -438,48 +574,28 @@ struct hb_krylov {
   double accept_tolerance = 1e-3;
   int max_iterations = 400;
   int restart = 100;
+  /// mean_jacobian: on the coarse aerofoil (H = 5) 255 / 370 GMRES iterations per point at 1.02 /
+  /// 1.05 Ubar* against 566 / 1200 with mean_state, equal near onset.
+  hb_preconditioner_state preconditioner = hb_preconditioner_state::mean_jacobian;
 
   template <dynamical_system S>
   class solver {
    public:
-    using C = std::complex<double>;
     solver(const hb_krylov& o, const internal::harmonic_balance_equations<S>& eq, const S& sys, const char* who)
         : o_(o), eq_(&eq), sys_(&sys), who_(who) {}
     int iterations() const { return iterations_; }
+    /// Bytes of the last solve's matrices, factors and GMRES basis (0 before the first).
+    std::size_t bytes() const { return bytes_; }
 
     vec<double> operator()(const vec<double>& x, const vec<double>& c, const vec<double>& rhs) {
       const auto& eq = *eq_;
-      const int nn = eq.instances(), h = (nn - 1) / 2;
+      const int nn = eq.instances();
       const Eigen::Index n = eq.n(), m = nn * n;
       const double omega = x[eq.omega_index()], mu = x[eq.mu_index()];
       const Eigen::Map<const Eigen::MatrixXd> w(x.data(), n, nn);
-      const Eigen::MatrixXd& d = eq.differentiation();
-      exact_.clear();
-      for (int j = 0; j < nn; ++j) exact_.push_back(krylov_exact_jacobian<B>(*sys_, vec<double>(w.col(j)), mu, who_));
-      const vec<double> wbar = w.rowwise().mean();
-      const auto pre = krylov_jacobians<B>(*sys_, wbar, mu, who_).preconditioning;
-      ilu_.clear();
-      for (int k = 0; k <= h; ++k) {
-        block_ilu_options bo;
-        bo.fill_level = o_.fill_level;
-        bo.context = internal::concat(who_, ": BILU(", o_.fill_level, ") of P - i ", k, " omega I");
-        ilu_.emplace_back(bo);
-        ilu_.back().compute(pre, C(0.0, k * omega));
-      }
-      // state part of the operator: y_j = A_j x_j - omega sum_k D_jk x_k
-      Eigen::MatrixXd dw = w * d.transpose();
-      auto state_op = [&](const vec<double>& v, vec<double>& y) {
-        const Eigen::Map<const Eigen::MatrixXd> vm(v.data(), n, nn);
-        Eigen::Map<Eigen::MatrixXd> ym(y.data(), n, nn);
-        ym.noalias() = -omega * (vm * d.transpose());
-        for (int j = 0; j < nn; ++j) {
-          tmp_in_ = vm.col(j);
-          tmp_out_.resize(n);
-          exact_[std::size_t(j)].apply(tmp_in_, tmp_out_);
-          ym.col(j) += tmp_out_;
-        }
-      };
-      // the full operator [[state, U], [V, corner]]
+      hill_.build(*sys_, w, mu, omega, 0.0, eq.differentiation(), o_.fill_level, o_.preconditioner, who_);
+      // the full operator [[Hill, U], [V, corner]]
+      const Eigen::MatrixXd dw = w * eq.differentiation().transpose();
       Eigen::MatrixXd u = Eigen::MatrixXd::Zero(m, 3), v = Eigen::MatrixXd::Zero(3, m), corner = Eigen::MatrixXd::Zero(3, 3);
       for (int j = 0; j < nn; ++j) {
         const vec<double> wj = w.col(j);
@@ -495,26 +611,13 @@ struct hb_krylov {
       state_out_.resize(m);
       auto op = [&](const vec<double>& z, vec<double>& y) {  // allocation-free: member buffers
         state_in_ = z.head(m);
-        state_op(state_in_, state_out_);
+        hill_.apply(state_in_, state_out_);
         y.head(m) = state_out_;
         y.head(m).noalias() += u * z.tail(3);
         y.tail(3).noalias() = v * z.head(m);
         y.tail(3).noalias() += corner * z.tail(3);
       };
-      // preconditioner of the state part: Fourier transform, shifted BILU per harmonic, back
-      auto state_pre = [&](const vec<double>& r, vec<double>& z) {
-        const Eigen::Map<const Eigen::MatrixXd> rm(r.data(), n, nn);
-        Eigen::Map<Eigen::MatrixXd> zm(z.data(), n, nn);
-        zm.setZero();
-        for (int k = 0; k <= h; ++k) {
-          rk_ = vec<C>::Zero(n);
-          for (int j = 0; j < nn; ++j) rk_ += rm.col(j).cast<C>() * std::polar(1.0 / nn, -2 * std::numbers::pi * k * j / nn);
-          zk_.resize(n);
-          ilu_[std::size_t(k)].apply(rk_, zk_);
-          for (int j = 0; j < nn; ++j)
-            zm.col(j) += (k == 0 ? 1.0 : 2.0) * (zk_ * std::polar(1.0, 2 * std::numbers::pi * k * j / nn)).real();
-        }
-      };
+      auto state_pre = [&](const vec<double>& r, vec<double>& z) { hill_.precondition(r, z); };
       internal::border_elimination<double> border;
       border.compute(state_pre, m, u, v, corner, internal::concat(who_, ": harmonic-balance border"));
       auto pre_full = [&](const vec<double>& r, vec<double>& z) { border.apply(state_pre, r, z); };
@@ -527,6 +630,8 @@ struct hb_krylov {
       vec<double> dx = vec<double>::Zero(rhs.size());
       const krylov_report rep = gmres<double>(op, pre_full, rhs, dx, ko);
       iterations_ += rep.iterations;
+      bytes_ = hill_.bytes() + std::size_t(std::min(o_.restart, o_.max_iterations) + 1 + 6) * std::size_t(m + 3) *
+                                   sizeof(double);
       if (!rep.converged && !(rep.relative_residual <= o_.accept_tolerance))
         throw convergence_error(internal::concat(ko.context, ": not converged in ", rep.iterations,
                                                  " iterations (relative residual ", rep.relative_residual, ", ",
@@ -539,11 +644,10 @@ struct hb_krylov {
     const internal::harmonic_balance_equations<S>* eq_;
     const S* sys_;
     const char* who_;
-    std::vector<bordered_block_matrix<double, B>> exact_;
-    std::vector<bordered_block_ilu<C, B>> ilu_;
-    vec<double> tmp_in_, tmp_out_, state_in_, state_out_;
-    vec<C> rk_, zk_;
+    internal::hill_operator<B, S> hill_;
+    vec<double> state_in_, state_out_;
     int iterations_ = 0;
+    std::size_t bytes_ = 0;
   };
   template <dynamical_system S>
   solver<S> make(const internal::harmonic_balance_equations<S>& eq, const S& sys, const char* who) const {
@@ -580,6 +684,7 @@ lco_solution solve_lco(const S& sys, const lco_solution& guess, const vec<double
   lco_solution s = eq.unpack(r.x);
   s.newton_iterations = r.iterations;
   s.linear_iterations = r.linear_iterations;
+  s.linear_bytes = r.linear_bytes;
   s.residual = r.residual;
   s.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return s;
@@ -592,6 +697,12 @@ struct floquet_result {
   double max_real = -INFINITY;                  ///< largest real part without the trivial one
   bool stable = false;                          ///< max_real < 0
   double period = 0;
+  /// hill_floquet: every exponent (complete). hill_floquet_krylov: only those whose copies lie
+  /// within `radius` of the real `shift` (the exponents near 0, the ones a cycle's stability
+  /// turns on next to a Hopf point or a fold); the rest of the spectrum is not seen.
+  bool complete = true;
+  double shift = 0, radius = INFINITY;
+  int linear_solves = 0, linear_iterations = 0;  ///< hill_floquet_krylov's GMRES work
   /// Floquet multipliers exp(sigma T).
   std::vector<std::complex<double>> multipliers() const {
     std::vector<std::complex<double>> m;
@@ -599,6 +710,38 @@ struct floquet_result {
     return m;
   }
 };
+
+namespace internal {
+/// The energy-weighted mean harmonic index kbar over k = -H .. H of a vector of Hill's matrix
+/// (N blocks of n): the Lazarus-Thomas criterion of the file comment.
+inline double mean_harmonic_index(const Eigen::Ref<const Eigen::VectorXcd>& v, Eigen::Index n, int h) {
+  const int nn = 2 * h + 1;
+  double e = 0, ke = 0;
+  Eigen::VectorXcd ck(n);
+  for (int k = -h; k <= h; ++k) {
+    ck.setZero();
+    for (int j = 0; j < nn; ++j) ck += v.segment(j * n, n) * std::polar(1.0, -2 * std::numbers::pi * k * j / nn);
+    const double ek = ck.squaredNorm();
+    e += ek;
+    ke += k * ek;
+  }
+  return e > 0 ? ke / e : 0.0;
+}
+
+/// Sorts by decreasing real part; the trivial exponent (the given one, else the one nearest 0),
+/// the largest other real part and the verdict.
+inline void classify_exponents(floquet_result& r, std::optional<std::complex<double>> trivial = std::nullopt) {
+  std::sort(r.exponents.begin(), r.exponents.end(), [](const auto& a, const auto& b) { return a.real() > b.real(); });
+  std::size_t it = 0;
+  for (std::size_t m = 1; m < r.exponents.size(); ++m)
+    if (trivial ? r.exponents[m] == *trivial : std::abs(r.exponents[m]) < std::abs(r.exponents[it])) it = m;
+  r.trivial = r.exponents[it];
+  r.max_real = -INFINITY;
+  for (std::size_t m = 0; m < r.exponents.size(); ++m)
+    if (m != it) r.max_real = std::max(r.max_real, r.exponents[m].real());
+  r.stable = r.max_real < 0;
+}
+}  // namespace internal
 
 struct hill_options {
   Eigen::Index max_size = 6000;  ///< largest N n for the dense eigen-decomposition
@@ -622,17 +765,8 @@ floquet_result hill_floquet(const S& sys, const lco_solution& s, const hill_opti
     double kbar;
   };
   std::vector<cand> cs;
-  for (Eigen::Index m = 0; m < lam.size(); ++m) {
-    double e = 0, ke = 0;
-    for (int k = -h; k <= h; ++k) {
-      Eigen::VectorXcd ck = Eigen::VectorXcd::Zero(n);
-      for (int j = 0; j < nn; ++j) ck += v.col(m).segment(j * n, n) * std::polar(1.0, -2 * std::numbers::pi * k * j / nn);
-      const double ek = ck.squaredNorm();
-      e += ek;
-      ke += k * ek;
-    }
-    cs.push_back({lam[m], e > 0 ? ke / e : 0.0});
-  }
+  for (Eigen::Index m = 0; m < lam.size(); ++m)
+    cs.push_back({lam[m], internal::mean_harmonic_index(v.col(m), n, h)});
   std::stable_sort(cs.begin(), cs.end(), [](const cand& a, const cand& b) {
     if (std::abs(a.kbar) != std::abs(b.kbar)) return std::abs(a.kbar) < std::abs(b.kbar);
     return std::abs(a.l.imag()) < std::abs(b.l.imag());
@@ -640,15 +774,171 @@ floquet_result hill_floquet(const S& sys, const lco_solution& s, const hill_opti
   floquet_result r;
   r.period = s.period();
   for (Eigen::Index m = 0; m < n; ++m) r.exponents.push_back(cs[std::size_t(m)].l);
-  std::sort(r.exponents.begin(), r.exponents.end(),
-            [](const auto& a, const auto& b) { return a.real() > b.real(); });
-  std::size_t it = 0;
-  for (std::size_t m = 1; m < r.exponents.size(); ++m)
-    if (std::abs(r.exponents[m]) < std::abs(r.exponents[it])) it = m;
-  r.trivial = r.exponents[it];
-  for (std::size_t m = 0; m < r.exponents.size(); ++m)
-    if (m != it) r.max_real = std::max(r.max_real, r.exponents[m].real());
-  r.stable = r.max_real < 0;
+  internal::classify_exponents(r);
+  return r;
+}
+
+/// Options of hill_floquet_krylov.
+struct hill_krylov_options {
+  /// real shift of the shift-invert Arnoldi; NaN: 0.01 omega (a shift near 0 separates the two
+  /// exponents nearest 0 from the rest: on the coarse aerofoil one pass of 10 instead of three)
+  double shift = NAN;
+  /// exponents centred on harmonic 0 to converge, nearest the shift first, the trivial one among
+  /// them (2: it and the exponent that decides stability next to a Hopf point or a fold)
+  int exponents = 2;
+  int subspace = 10;          ///< Arnoldi basis size (one GMRES solve per vector)
+  int restarts = 4;           ///< explicit restarts from the unconverged Ritz vectors
+  double tolerance = 1e-7;    ///< ||Hill x - lambda x|| <= tolerance max(1, |lambda|) ||x||
+  int fill_level = 1;         ///< of the per-harmonic BILU(k)
+  hb_preconditioner_state preconditioner = hb_preconditioner_state::mean_jacobian;
+  double linear_tolerance = 1e-8;  ///< relative, of each GMRES solve
+  int max_iterations = 1000, restart = 100;
+};
+
+/// The Floquet exponents of a cycle nearest 0 by Hill's method without forming Hill's matrix, for
+/// CFD-sized systems: shift-invert Arnoldi on Hill's matrix (the exact bordered Jacobians of the
+/// instances, blocks of B) at a real shift sigma, each (Hill - sigma I) x = v by GMRES with the
+/// harmonic preconditioner of hb_krylov shifted by sigma. The Ritz pairs are taken nearest sigma
+/// first while their true residuals meet the tolerance (so that no eigenvalue within the radius
+/// of the last one is missed), until `exponents` of them are centred on harmonic 0 (|kbar| <=
+/// 1/2, the file comment's criterion) with the trivial one among them, identified by its
+/// eigenvector (parallel to dw/dtau: a phase shift of the cycle); explicit restarts from those
+/// Ritz vectors otherwise. The verdict is as in hill_floquet. sigma a little right of 0 puts an
+/// unstable exponent near 0 nearer than a stable one. The result is partial
+/// (floquet_result::complete false, radius = the distance of the farthest converged eigenvalue
+/// from sigma): an exponent farther out (a secondary bifurcation far from onset) is not seen.
+/// Throws convergence_error when a GMRES solve fails or the Arnoldi passes do not converge.
+template <int B, dynamical_system S>
+floquet_result hill_floquet_krylov(const S& sys, const lco_solution& s, const hill_krylov_options& o = {}) {
+  using C = std::complex<double>;
+  const char* who = "hill_floquet_krylov";
+  internal::check_guess(sys, s, vec<double>::Ones(sys.size()), who);
+  require(o.exponents >= 1 && o.subspace > o.exponents + 2 && o.restarts >= 0 && std::isfinite(o.tolerance) &&
+              o.tolerance > 0 && o.fill_level >= 0 && std::isfinite(o.linear_tolerance) && o.linear_tolerance > 0 &&
+              o.max_iterations >= 1 && o.restart >= 1 && !std::isinf(o.shift),
+          who, ": options out of range (exponents ", o.exponents, ", subspace ", o.subspace, " > exponents + 2, restarts ",
+          o.restarts, ", tolerance ", o.tolerance, ", fill_level ", o.fill_level, ", linear_tolerance ",
+          o.linear_tolerance, ", shift ", o.shift, ")");
+  const Eigen::Index n = sys.size();
+  const int h = s.harmonics, nn = s.instance_count();
+  const Eigen::Index m = n * nn;
+  const double sigma = std::isnan(o.shift) ? 0.01 * s.omega : o.shift;
+  const Eigen::MatrixXd d = fourier_differentiation_matrix(nn);
+  internal::hill_operator<B, S> hill;
+  hill.build(sys, s.instances, s.mu, s.omega, sigma, d, o.fill_level, o.preconditioner, who);
+  auto op = [&](const vec<double>& x, vec<double>& y) { hill.apply(x, y); };
+  auto pre = [&](const vec<double>& r, vec<double>& z) { hill.precondition(r, z); };
+  krylov_options ko;
+  ko.relative_tolerance = o.linear_tolerance;
+  ko.max_iterations = o.max_iterations;
+  ko.restart = o.restart;
+  ko.record_history = false;
+  ko.context = internal::concat(who, ": GMRES on Hill's matrix - ", sigma, " I");
+  int solves = 0, iterations = 0;
+  auto solve = [&](const vec<double>& v) {
+    vec<double> x = vec<double>::Zero(m);
+    const krylov_report rep = gmres<double>(op, pre, v, x, ko);
+    ++solves;
+    iterations += rep.iterations;
+    if (!rep.converged)
+      throw convergence_error(internal::concat(ko.context, ": solve ", solves, " not converged in ", rep.iterations,
+                                               " iterations (relative residual ", rep.relative_residual, ", ",
+                                               rep.reason, ")"));
+    return x;
+  };
+  const int msub = int(std::min<Eigen::Index>(o.subspace, m));
+  vec<double> v0(m);
+  for (Eigen::Index i = 0; i < m; ++i) v0[i] = 1 + 0.3 * std::sin(0.9 * double(i)) + 0.2 * std::cos(2.3 * double(i));
+  std::vector<C> lambda;
+  std::vector<double> kbar, align;  // align: |cos| between the eigenvector and dw/dtau (the trivial one's)
+  vec<double> dw(m);
+  Eigen::Map<Eigen::MatrixXd>(dw.data(), n, nn) = s.instances * d.transpose();
+  double radius = 0, worst = 0;
+  vec<double> tr(m), ti(m);
+  for (int pass = 0; pass <= o.restarts; ++pass) {
+    Eigen::MatrixXd v(m, msub + 1), hh = Eigen::MatrixXd::Zero(msub + 1, msub);
+    v.col(0) = v0.normalized();
+    int k = msub;
+    for (int j = 0; j < msub; ++j) {
+      vec<double> w = solve(v.col(j));
+      for (int twice = 0; twice < 2; ++twice)  // classical Gram-Schmidt, twice
+        for (int i = 0; i <= j; ++i) {
+          const double hij = v.col(i).dot(w);
+          hh(i, j) += hij;
+          w -= hij * v.col(i);
+        }
+      hh(j + 1, j) = w.norm();
+      if (!(hh(j + 1, j) > 1e-14 * hh.col(j).head(j + 1).norm())) {  // an invariant subspace
+        k = j + 1;
+        break;
+      }
+      v.col(j + 1) = w / hh(j + 1, j);
+    }
+    Eigen::EigenSolver<Eigen::MatrixXd> es(hh.topLeftCorner(k, k), true);
+    require(es.info() == Eigen::Success, who, ": the eigen-decomposition of the Arnoldi matrix failed");
+    std::vector<int> idx(std::size_t(k), 0);
+    for (int i = 0; i < k; ++i) idx[std::size_t(i)] = i;
+    std::sort(idx.begin(), idx.end(),
+              [&](int a, int b) { return std::abs(es.eigenvalues()[a]) > std::abs(es.eigenvalues()[b]); });
+    lambda.clear();
+    kbar.clear();
+    align.clear();
+    radius = worst = 0;
+    v0.setZero();
+    // the converged prefix of the Ritz values ordered by distance from sigma: complete within its radius
+    bool prefix = true;
+    int centred = 0;
+    bool has_trivial = false;
+    for (int r = 0; r < k; ++r) {
+      const C theta = es.eigenvalues()[idx[std::size_t(r)]];
+      const Eigen::VectorXcd x = v.leftCols(k).cast<C>() * es.eigenvectors().col(idx[std::size_t(r)]);
+      const C lam = sigma + 1.0 / theta;
+      const vec<double> xr = x.real(), xi = x.imag();
+      hill.apply(xr, tr);
+      hill.apply(xi, ti);
+      const double res = (tr.cast<C>() + C(0, 1) * ti.cast<C>() - x / theta).norm() / x.norm();
+      const double rel = res / std::max(1.0, std::abs(lam));
+      if (rel <= o.tolerance && prefix) {
+        lambda.push_back(lam);
+        kbar.push_back(internal::mean_harmonic_index(x, n, h));
+        align.push_back(std::abs(dw.cast<C>().dot(x)) / (dw.norm() * x.norm()));
+        radius = std::abs(lam - sigma);
+        if (std::abs(kbar.back()) <= 0.5) {
+          ++centred;
+          has_trivial = has_trivial || align.back() >= 0.9;
+        }
+      } else {
+        if (prefix) worst = rel;
+        prefix = false;
+      }
+      v0 += (xr + xi) / x.norm();  // the restart: the Ritz vectors up to the wanted ones
+      if (centred >= o.exponents && has_trivial) break;
+      if (!prefix && r + 1 >= o.exponents + 2) break;
+    }
+    if ((centred >= o.exponents && has_trivial) || k < msub) break;
+    if (pass == o.restarts)
+      throw convergence_error(internal::concat(
+          who, ": ", centred, " exponents centred on harmonic 0", has_trivial ? " (the trivial one among them)" : "",
+          " in the converged ", lambda.size(), " eigenvalues of Hill's matrix nearest ", sigma, ", ", o.exponents,
+          " wanted, after ", o.restarts + 1, " Arnoldi passes of ", msub, " (", solves,
+          " GMRES solves; first unconverged relative residual ", worst, ", tolerance ", o.tolerance, ")"));
+  }
+  floquet_result r;
+  r.period = s.period();
+  r.complete = false;
+  r.shift = sigma;
+  r.radius = radius;
+  r.linear_solves = solves;
+  r.linear_iterations = iterations;
+  std::optional<C> trivial;
+  double best = 0;
+  for (std::size_t q = 0; q < lambda.size(); ++q)
+    if (std::abs(kbar[q]) <= 0.5) {
+      r.exponents.push_back(lambda[q]);
+      if (align[q] > best) best = align[q], trivial = lambda[q];
+    }
+  require(best >= 0.9, who, ": internal: the trivial exponent was not kept");
+  internal::classify_exponents(r, trivial);
   return r;
 }
 
@@ -702,12 +992,14 @@ lco_branch trace_lco_branch(const S& sys, const lco_solution& start, const vec<d
   const bool hill = o.stability && sys.size() * start.instance_count() <= o.hill.max_size;
   lco_branch out;
   int last_linear = start.linear_iterations;
+  std::size_t last_bytes = start.linear_bytes;
   auto record = [&](const vec<double>& x, int iterations, double residual, bool landed, double seconds) {
     const auto t0 = std::chrono::steady_clock::now();
     lco_branch_point p;
     p.cycle = eq.unpack(x);
     p.cycle.newton_iterations = iterations;
     p.cycle.linear_iterations = last_linear;
+    p.cycle.linear_bytes = last_bytes;
     p.cycle.residual = residual;
     p.probe_amplitude = probe_peak_amplitude(p.cycle, probe);
     if (hill) p.floquet = hill_floquet(sys, p.cycle, o.hill);
@@ -733,6 +1025,7 @@ lco_branch trace_lco_branch(const S& sys, const lco_solution& start, const vec<d
         try {
           const auto r = internal::hb_newton(eq, q.x0, q.c, q.value, o.newton, who, lin);
           last_linear = r.linear_iterations;
+          last_bytes = r.linear_bytes;
           corrected c;
           c.x = r.x;
           c.iterations = r.iterations;

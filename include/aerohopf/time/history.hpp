@@ -1,7 +1,9 @@
 #pragma once
 // A stored time history (t_k, y_k) shared by the explicit and implicit integrators, and the
 // step count rule they share: a requested step dt is rounded down so that an integer number
-// of equal steps ends exactly on t_end (histories of different runs then align in time).
+// of equal steps ends exactly on t_end (histories of different runs then align in time). The
+// measures of a sampled oscillation: growth rate, amplitude envelope, the limit cycle that runs
+// approach from both sides, and the amplitude and period of a settled run.
 #include <algorithm>
 #include <cmath>
 #include <string>
@@ -120,6 +122,49 @@ inline std::vector<amplitude_sample> amplitude_envelope(const std::vector<double
     r[k].growth_rate = std::log(r[b].amplitude / r[a].amplitude) / (r[b].t - r[a].t);
   }
   return r;
+}
+
+/// A limit cycle found from the envelopes of time-marching runs (limit_cycle_from_envelopes).
+struct envelope_cycle {
+  double amplitude = NAN;  ///< where the fitted growth rate vanishes
+  double slope = NAN;      ///< d sigma / dA of the fit
+  double exponent = NAN;   ///< amplitude * slope: the cycle's radial Floquet exponent (< 0: stable)
+  int samples = 0;         ///< finite growth-rate samples used
+  bool bracketed = false;  ///< samples on both sides of the amplitude (an interpolation)
+};
+
+/// The limit cycle that runs approach from inside and outside (or leave, if it is unstable): the
+/// line sigma(A) = s0 + s1 A fitted by least squares to the growth rates of every envelope
+/// sample of every run (amplitude_envelope); its zero A* is the cycle's amplitude, and A* s1 is
+/// its radial Floquet exponent (the derivative of dA/dt = sigma(A) A at A*). Runs started at 0.9
+/// and 1.1 times a cycle bracket it, so the line interpolates over a range where sigma(A) is
+/// nearly linear, long before either run has settled. Throws input_error with fewer than three
+/// finite samples or a single amplitude, convergence_error when the fitted slope is zero.
+inline envelope_cycle limit_cycle_from_envelopes(const std::vector<std::vector<amplitude_sample>>& runs) {
+  const char* who = "limit_cycle_from_envelopes";
+  double sx = 0, sy = 0, sxx = 0, sxy = 0, amin = INFINITY, amax = -INFINITY;
+  int ns = 0;
+  for (const auto& run : runs)
+    for (const amplitude_sample& e : run) {
+      if (!std::isfinite(e.growth_rate) || !std::isfinite(e.amplitude)) continue;
+      sx += e.amplitude, sy += e.growth_rate, sxx += e.amplitude * e.amplitude, sxy += e.amplitude * e.growth_rate;
+      amin = std::min(amin, e.amplitude);
+      amax = std::max(amax, e.amplitude);
+      ++ns;
+    }
+  require(ns >= 3, who, ": ", ns, " finite envelope samples (at least 3 needed: run longer)");
+  require(amax > amin, who, ": every sample has the amplitude ", amin, ": no growth-rate line");
+  envelope_cycle c;
+  c.samples = ns;
+  c.slope = (ns * sxy - sx * sy) / (ns * sxx - sx * sx);
+  const double s0 = (sy - c.slope * sx) / ns;
+  if (!(std::abs(c.slope) > 0) || !std::isfinite(c.slope))
+    throw convergence_error(internal::concat(who, ": the growth rate does not change with the amplitude (slope ", c.slope,
+                                             " over ", ns, " samples, amplitudes ", amin, " .. ", amax, ")"));
+  c.amplitude = -s0 / c.slope;
+  c.exponent = c.amplitude * c.slope;
+  c.bracketed = amin < c.amplitude && c.amplitude < amax;
+  return c;
 }
 
 /// What a run that has settled on a limit cycle shows over its last cycles (last_cycles).
