@@ -32,7 +32,8 @@
 // criterion of Lazarus & Thomas, C. R. Mecanique 338, 2010). The trivial exponent (the phase
 // shift, exactly 0 for the continuous problem: its distance from 0 measures the truncation) is
 // the one nearest 0, and the cycle is stable when every other exponent has Re < 0. Dense: for
-// N n up to hill_options::max_size.
+// N n up to hill_options::max_size; hill_floquet_krylov<B> finds the exponents nearest 0 of
+// CFD-sized cycles by shift-invert Arnoldi without forming the matrix (see there).
 #include <Eigen/Core>
 #include <Eigen/Eigenvalues>
 #include <Eigen/SparseCore>
