@@ -210,6 +210,8 @@ TEST(HarmonicBalance, QuinticBranchPassesTheFoldAndChangesStabilityThere) {
       EXPECT_TRUE(std::abs(p.cycle.mu + 0.2) < 1e-12 || std::abs(p.cycle.mu + 0.1) < 1e-12) << p.cycle.mu;
     }
   EXPECT_GE(landed, 2);
+  o.fast_iterations = -1;
+  EXPECT_THROW(trace_lco_branch(s, start, e, o), input_error);
 }
 
 TEST(HarmonicBalance, VanDerPolCycleConvergesSpectrallyToThePublishedPeriod) {
@@ -346,6 +348,19 @@ TEST(HarmonicBalance, KrylovStrategyEqualsSparseLuOnTheAerofoil) {
   EXPECT_NEAR(krylov.omega, direct.omega, 1e-8 * direct.omega);
   EXPECT_LT((krylov.instances - direct.instances).cwiseAbs().maxCoeff(), 1e-7);
   EXPECT_NE(krylov.mu, h.point.mu);  // a finite cycle: off the Hopf point
+  // the inexact-Newton forcing against a fixed 1e-6 per solve: the same cycle (the Newton test
+  // decides), fewer GMRES iterations
+  hb_krylov<4> fixed;
+  fixed.adaptive_tolerance = false;
+  const lco_solution tight = solve_lco(s, g, e, lco_fix::amplitude, std::nullopt, ho, fixed);
+  std::printf("  GMRES iterations: %d with the forcing, %d at 1e-6 (Newton %d, %d)\n", krylov.linear_iterations,
+              tight.linear_iterations, krylov.newton_iterations, tight.newton_iterations);
+  EXPECT_NEAR(tight.mu, krylov.mu, 1e-8 * std::abs(direct.mu));
+  EXPECT_LT(krylov.linear_iterations, tight.linear_iterations);
+  EXPECT_LE(krylov.residual, ho.tolerance);
+  hb_krylov<4> bad;
+  bad.eta_max = 1;
+  EXPECT_THROW(solve_lco(s, g, e, lco_fix::amplitude, std::nullopt, ho, bad), input_error);
 }
 
 TEST(HarmonicBalance, KrylovHillExponentsEqualTheDenseOnesAndTheClosedForms) {
