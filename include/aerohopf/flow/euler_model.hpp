@@ -263,10 +263,8 @@ class euler_model {
   void require_physical(const S* w, std::string_view where) const {
     const auto d = first_nonphysical_cell<S>(w);
     if (!d) return;
-    std::ostringstream ij;
-    for (int e = 0; e < Dim; ++e) ij << (e ? "," : "") << d->cell[e];
-    throw input_error(aerohopf::internal::concat(where, ": block ", d->block, " cell (", ij.str(), ") (state cell ",
-                                                 d->global, "): density ", d->density, ", pressure ", d->pressure,
+    throw input_error(aerohopf::internal::concat(where, ": ", cell_name(d->global), " (state cell ", d->global,
+                                                 "): density ", d->density, ", pressure ", d->pressure,
                                                  ": not a physical state (both must be positive and finite)"));
   }
 
