@@ -603,8 +603,8 @@ struct hb_krylov {
   double accept_tolerance = 1e-3;
   int max_iterations = 400;
   int restart = 50;  ///< against 100: a quarter less time for the coarse aerofoil's branch, half the basis
-  /// mean_jacobian: on the coarse aerofoil (H = 5) 255 / 370 GMRES iterations per point at 1.02 /
-  /// 1.05 Ubar* against 566 / 1200 with mean_state, equal near onset.
+  /// mean_jacobian: on the coarse aerofoil (H = 5, GMRES to 1e-6) 255 / 370 GMRES iterations per
+  /// point at 1.02 / 1.05 Ubar* against 566 / 1200 with mean_state, equal near onset.
   hb_preconditioner_state preconditioner = hb_preconditioner_state::mean_jacobian;
 
   template <dynamical_system S>
