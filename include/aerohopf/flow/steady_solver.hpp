@@ -298,9 +298,7 @@ steady_report solve_steady(euler_model<Dim>& m, vec<double>& w, const steady_opt
               worst_norm = v;
               worst = c;
             }
-          std::string cell;
-          if constexpr (requires { m.cell_name(std::size_t{}); }) cell = m.cell_name(static_cast<std::size_t>(worst));
-          else cell = aerohopf::internal::concat("state cell ", worst);
+          const std::string cell = m.cell_name(static_cast<std::size_t>(worst));
           return fail(aerohopf::internal::concat(
               "Newton stalled: ", opt.stall_steps, " steps with the exact Jacobian took ||R|| only from ", before, " to ",
               best, " (GMRES at ", lin.iterations, " of at most ", opt.linear_max_iterations,
