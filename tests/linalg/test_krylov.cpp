@@ -219,7 +219,11 @@ TEST(Krylov, GmresSecondPassWhereNeededMatchesTheSecondPassAlways) {
   EXPECT_LT((x_needed - x_ref).norm(), 1e-8 * x_ref.norm());
   for (std::size_t k = 0; k < std::min(needed.residual_history.size(), always.residual_history.size()); ++k)
     EXPECT_NEAR(std::log10(needed.residual_history[k]), std::log10(always.residual_history[k]), 0.05) << k;
-  // out of range: refused at the entry
+}
+
+TEST(Krylov, ReorthogonalizationThresholdOutOfRangeIsRefused) {
+  const auto a = shifted(convection_diffusion<double, 4>(6, 6, 4, 0.5, 0.5, 7), cd(0, 0));
+  const vec<cd> b = vec<cd>::Random(a.rows());
   for (const double bad : {-0.1, 1.5, std::numeric_limits<double>::quiet_NaN()}) {
     krylov_options ob;
     ob.reorthogonalization_threshold = bad;
