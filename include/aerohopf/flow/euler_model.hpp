@@ -240,13 +240,23 @@ class euler_model {
   template <class S>
   std::optional<state_defect> first_nonphysical_cell(const S* w) const {
     for (std::size_t b = 0; b + 1 < offset_.size(); ++b)
-      for (std::size_t c = offset_[b]; c < offset_[b + 1]; ++c) {
-        state<double, Dim> s;
-        for (int v = 0; v < nv; ++v) s[v] = to_double(w[c * nv + v]);
-        const auto q = to_primitive<double, Dim>(s);
-        if (!(q.rho > 0.0 && q.p > 0.0 && std::isfinite(q.rho) && std::isfinite(q.p)))
-          return state_defect{static_cast<int>(b), unravel<Dim>(c - offset_[b], grid_.topology.cells[b]), c, q.rho, q.p};
-      }
+      for (std::size_t c = offset_[b]; c < offset_[b + 1]; ++c)
+        if (auto d = cell_defect<S>(w, static_cast<int>(b), c)) return d;
+    return std::nullopt;
+  }
+
+  /// As first_nonphysical_cell, over the cells a block-restricted residual reads: those of the
+  /// selected blocks (blocks[b] != 0), then the donors of their halos in other blocks.
+  template <class S>
+  std::optional<state_defect> first_nonphysical_cell(const S* w, const std::vector<char>& blocks) const {
+    for (std::size_t b = 0; b + 1 < offset_.size(); ++b)
+      if (blocks[b])
+        for (std::size_t c = offset_[b]; c < offset_[b + 1]; ++c)
+          if (auto d = cell_defect<S>(w, static_cast<int>(b), c)) return d;
+    for (const auto& h : halos_)
+      if (blocks[h.block] && !blocks[h.donor_block])
+        for (const std::size_t c : {offset_[h.donor_block] + h.donor, offset_[h.donor_block] + h.donor2})
+          if (auto d = cell_defect<S>(w, h.donor_block, c)) return d;
     return std::nullopt;
   }
 
@@ -261,12 +271,33 @@ class euler_model {
   /// ...") for the first non-physical cell of w (n_cells() * nv values, not checked).
   template <class S>
   void require_physical(const S* w, std::string_view where) const {
-    const auto d = first_nonphysical_cell<S>(w);
+    report_defect(first_nonphysical_cell<S>(w), where);
+  }
+
+  /// require_physical over the cells a block-restricted residual reads (see residual_of_blocks).
+  template <class S>
+  void require_physical(const S* w, const std::vector<char>& blocks, std::string_view where) const {
+    report_defect(first_nonphysical_cell<S>(w, blocks), where);
+  }
+
+ private:
+  template <class S>
+  std::optional<state_defect> cell_defect(const S* w, int b, std::size_t c) const {
+    state<double, Dim> s;
+    for (int v = 0; v < nv; ++v) s[v] = to_double(w[c * nv + v]);
+    const auto q = to_primitive<double, Dim>(s);
+    if (q.rho > 0.0 && q.p > 0.0 && std::isfinite(q.rho) && std::isfinite(q.p)) return std::nullopt;
+    return state_defect{b, unravel<Dim>(c - offset_[b], grid_.topology.cells[b]), c, q.rho, q.p};
+  }
+
+  void report_defect(const std::optional<state_defect>& d, std::string_view where) const {
     if (!d) return;
     throw input_error(aerohopf::internal::concat(where, ": ", cell_name(d->global), " (state cell ", d->global,
                                                  "): density ", d->density, ", pressure ", d->pressure,
                                                  ": not a physical state (both must be positive and finite)"));
   }
+
+ public:
 
   /// R(w) with the model's own (double) metrics. Checks the size and the physical state of w.
   template <class S>
@@ -298,15 +329,40 @@ class euler_model {
   void residual(const grid_metrics<S, Dim>& m, const S* w, S* r) const {
     check_metrics(m);
     require_physical<S>(w, "euler_model::residual");
+    residual_unchecked<S>(m, w, r, nullptr);
+  }
+
+  /// R(w) in the cells of the selected blocks only (blocks[b] != 0, one entry per block); the
+  /// values of r at other blocks' cells are left as they were. This is the evaluation of one
+  /// rank that owns those blocks (distributed/partition.hpp): w must hold the states of the
+  /// selected blocks' cells and of the donors of their halos (halo_plan lists those in other
+  /// blocks); no other cell of w is read. Each selected cell's value is bitwise the full
+  /// residual's. Checks the metrics, the selection's size and the physical state of the cells
+  /// read.
+  template <class S>
+  void residual_of_blocks(const grid_metrics<S, Dim>& m, const S* w, S* r, const std::vector<char>& blocks) const {
+    check_metrics(m);
+    require_size(blocks.size(), pdims_.size(), "euler_model::residual_of_blocks", "block selection");
+    require_physical<S>(w, blocks, "euler_model::residual_of_blocks");
+    residual_unchecked<S>(m, w, r, &blocks);
+  }
+
+ private:
+  template <class S>
+  void residual_unchecked(const grid_metrics<S, Dim>& m, const S* w, S* r, const std::vector<char>* selected) const {
     std::vector<std::vector<state<S, Dim>>> padded;
-    fill_padded<S>(m, w, padded);
+    fill_padded<S>(m, w, padded, selected);
     std::vector<std::vector<primitive<S, Dim>>> prim(padded.size());
     for (std::size_t b = 0; b < padded.size(); ++b) {
       prim[b].resize(padded[b].size());
       for (std::size_t k = 0; k < padded[b].size(); ++k) prim[b][k] = to_primitive<S, Dim>(padded[b][k]);
     }
-    for (std::size_t k = 0; k < n_cells() * nv; ++k) r[k] = S(0.0);
     for (std::size_t b = 0; b < padded.size(); ++b) {
+      if (selected && !(*selected)[b]) continue;
+      for (std::size_t k = offset_[b] * nv; k < offset_[b + 1] * nv; ++k) r[k] = S(0.0);
+    }
+    for (std::size_t b = 0; b < padded.size(); ++b) {
+      if (selected && !(*selected)[b]) continue;
       const auto& mb = m.blocks[b];
       const auto& pd = pdims_[b];
       S* rb = r + offset_[b] * nv;
@@ -336,6 +392,8 @@ class euler_model {
         for (int v = 0; v < nv; ++v) rb[c * nv + v] /= mb.volume[c];
     }
   }
+
+ public:
 
   /// Flux through the face between padded cells cm and cm + stride of one block.
   template <class S>
@@ -580,11 +638,18 @@ class euler_model {
   /// Fills per-block padded arrays (interior copied from w, halos derived from donors,
   /// unused corners set to the free stream). Internal: w must hold size() values (not checked;
   /// every public entry point checks before calling this).
+  /// With `selected`, only the selected blocks (and their halos) are filled; the others are left
+  /// empty.
   template <class S>
-  void fill_padded(const grid_metrics<S, Dim>& m, const S* w, std::vector<std::vector<state<S, Dim>>>& padded) const {
+  void fill_padded(const grid_metrics<S, Dim>& m, const S* w, std::vector<std::vector<state<S, Dim>>>& padded,
+                   const std::vector<char>* selected = nullptr) const {
     const auto winf = fs_.conservative_state<S, Dim>();
     padded.resize(pdims_.size());
     for (std::size_t b = 0; b < pdims_.size(); ++b) {
+      if (selected && !(*selected)[b]) {
+        padded[b].clear();
+        continue;
+      }
       padded[b].assign(product<Dim>(pdims_[b]), winf);
       const auto& cells = grid_.topology.cells[b];
       const std::size_t nc = product<Dim>(cells);
@@ -597,6 +662,7 @@ class euler_model {
       }
     }
     for (const auto& h : halos_) {
+      if (selected && !(*selected)[h.block]) continue;
       state<S, Dim> donor, donor2;
       const S* src = w + (offset_[h.donor_block] + h.donor) * nv;
       const S* src2 = w + (offset_[h.donor_block] + h.donor2) * nv;

@@ -1,0 +1,89 @@
+// The Euler residual on MPI ranks (distributed/mpi_euler.hpp), run by CTest under mpirun on 2 and
+// 3 ranks (tests/CMakeLists.txt): every rank's residual rows equal the serial residual's
+// bitwise on the NACA 0012 C-grid (2D) and a row of three boxes (3D); local parts and the
+// gathered state round-trip; a bad local size or a non-physical cell on one rank makes every
+// rank throw (collective errors), and the ranks go on working afterwards.
+#include <gtest/gtest.h>
+#include <mpi.h>
+
+#include <aerohopf/distributed/mpi_euler.hpp>
+
+#include <string>
+#include "support/error_messages.hpp"
+#include "support/partition_grids.hpp"
+
+using namespace aerohopf;
+using namespace aerohopf::distributed;
+using aerohopf::test::contains;
+
+namespace {
+
+int world_size() {
+  int n = 0;
+  MPI_Comm_size(MPI_COMM_WORLD, &n);
+  return n;
+}
+
+template <int Dim>
+void check_residual(const flow::euler_model<Dim>& m) {
+  distributed_euler<Dim> d(m, partition_blocks(m, world_size()), MPI_COMM_WORLD);
+  const vec<double> w = test::perturbed_free_stream(m, 3u);  // the same on every rank (same seed)
+  const vec<double> local = d.local_part(w);
+  EXPECT_EQ(local.size(), d.local_size());
+  EXPECT_EQ(d.all_gather(local), w);
+  const vec<double> r = d.residual(local);
+  const vec<double> serial = m.residual(w);
+  EXPECT_EQ(r, d.local_part(serial)) << "rank " << d.rank();
+  EXPECT_EQ(d.all_gather(r), serial);
+  // a second evaluation at another state reuses the buffers
+  const vec<double> w2 = test::perturbed_free_stream(m, 4u);
+  EXPECT_EQ(d.residual(d.local_part(w2)), d.local_part(m.residual(w2)));
+}
+
+}  // namespace
+
+TEST(mpi_euler, residual_rows_equal_the_serial_residual_2d) {
+  check_residual(flow::euler_model<2>(test::partition_cgrid(), {.mach = 0.8, .alpha_rad = 0.02}));
+}
+
+TEST(mpi_euler, residual_rows_equal_the_serial_residual_3d) {
+  check_residual(flow::euler_model<3>(test::box_row_3d(), {.mach = 0.8, .alpha_rad = 0.05, .beta_rad = 0.02}));
+}
+
+TEST(mpi_euler, errors_are_collective) {
+  const flow::euler_model<2> m(test::partition_cgrid(), {.mach = 0.8});
+  distributed_euler<2> d(m, partition_blocks(m, world_size()), MPI_COMM_WORLD);
+  const vec<double> w = test::perturbed_free_stream(m, 5u);
+  vec<double> local = d.local_part(w);
+  // the last rank passes a state of the wrong size: every rank throws
+  const int last = world_size() - 1;
+  const vec<double> bad_size = d.rank() == last ? vec<double>(local.head(local.size() - 1)) : local;
+  const std::string msg = test::input_error_of([&] { d.residual(bad_size); });
+  if (d.rank() == last)
+    EXPECT_TRUE(contains(msg, "distributed_euler::exchange")) << msg;
+  else
+    EXPECT_TRUE(contains(msg, "refused on rank " + std::to_string(last))) << msg;
+  // rank 0 holds a negative density: every rank throws, rank 0 naming the cell
+  vec<double> bad = local;
+  if (d.rank() == 0) bad[4 * 5] = -1.0;
+  const std::string msg2 = test::input_error_of([&] { d.residual(bad); });
+  if (d.rank() == 0)
+    EXPECT_TRUE(contains(msg2, "not a physical state")) << msg2;
+  else
+    EXPECT_TRUE(contains(msg2, "refused on rank 0")) << msg2;
+  // and the ranks carry on
+  EXPECT_EQ(d.residual(local), d.local_part(m.residual(w)));
+  // a partition for another number of ranks is refused on every rank
+  const auto wrong = partition_blocks(m, world_size() == 3 ? 2 : 3);
+  EXPECT_THROW(distributed_euler<2>(m, wrong, MPI_COMM_WORLD), input_error);
+}
+
+int main(int argc, char** argv) {
+  MPI_Init(&argc, &argv);
+  ::testing::InitGoogleTest(&argc, argv);
+  const int failed = RUN_ALL_TESTS();
+  int any = 0;
+  MPI_Allreduce(&failed, &any, 1, MPI_INT, MPI_MAX, MPI_COMM_WORLD);
+  MPI_Finalize();
+  return any;
+}
