@@ -2,7 +2,8 @@
 // directional derivative of the residual (independent: one jet pass through the whole
 // residual, halos and all) on a moving C-grid (wall, far field, wake cut, block interfaces) and
 // a 3D two-block grid; block counts per row (9/5 in 2D, 13/7 in 3D); modified order = exact
-// Jacobian of the first-order scheme.
+// Jacobian of the first-order scheme; the rows of selected blocks in a local numbering (one
+// rank's part) against the whole Jacobian.
 #include <gtest/gtest.h>
 
 #include <aerohopf/flow/jacobian.hpp>
@@ -231,4 +232,65 @@ TEST(jacobian, non_physical_state_in_3d_names_the_three_cell_indices) {
     EXPECT_TRUE(contains(msg, "cell (2,1,1)")) << msg;
     EXPECT_TRUE(contains(msg, "density -0.5")) << msg;
   }
+}
+
+// The rows of some blocks in a local numbering (one rank's part, distributed/mpi_euler.hpp): the
+// selected blocks' cells first, the other cells after them in reverse order; every block of every
+// row equals the whole Jacobian's bitwise, no more blocks than it has; cells outside the
+// selected blocks and their halos' donors are not read (NaN there). A numbering that breaks its
+// contract is refused.
+TEST(jacobian, rows_of_selected_blocks_in_a_local_numbering_equal_the_whole_jacobians) {
+  std::mt19937 rng(41);
+  const auto m = moving_cgrid_model(2);
+  const vec<double> w = perturbed_state<2>(m, rng, 0.02);
+  const std::size_t nb = m.grid().topology.cells.size();
+  for (auto kind : {jacobian_kind::exact, jacobian_kind::modified_order})
+    for (std::size_t sel = 0; sel < nb; ++sel) {
+      SCOPED_TRACE(testing::Message() << "block " << sel << (kind == jacobian_kind::exact ? " exact" : " modified"));
+      block_sparse_matrix<double, 4> whole, part;
+      assemble_jacobian<2>(m, w, kind, whole);
+      jacobian_numbering num;
+      num.blocks.assign(nb, 0);
+      num.blocks[sel] = 1;
+      num.local.assign(m.n_cells(), -1);
+      Eigen::Index k = 0;
+      for (std::size_t c = m.cell_offset(static_cast<int>(sel)); c < m.cell_offset(static_cast<int>(sel) + 1); ++c)
+        num.local[c] = k++;
+      num.rows = k;
+      std::vector<char> read(m.n_cells(), 0);
+      for (const auto& h : m.halos())
+        if (static_cast<std::size_t>(h.block) == sel && static_cast<std::size_t>(h.donor_block) != sel)
+          read[m.cell_offset(h.donor_block) + h.donor] = read[m.cell_offset(h.donor_block) + h.donor2] = 1;
+      vec<double> view = w;
+      for (std::size_t c = m.n_cells(); c-- > 0;) {
+        if (num.local[c] >= 0) continue;
+        if (read[c])
+          num.local[c] = k++;
+        else
+          view.segment(static_cast<Eigen::Index>(4 * c), 4).setConstant(std::nan(""));
+      }
+      num.cols = k;
+      assemble_jacobian<2>(m, view, kind, part, &num);
+      ASSERT_EQ(part.block_rows(), num.rows);
+      std::vector<Eigen::Index> global_of(num.cols);
+      for (std::size_t c = 0; c < m.n_cells(); ++c)
+        if (num.local[c] >= 0) global_of[num.local[c]] = static_cast<Eigen::Index>(c);
+      for (Eigen::Index r = 0; r < part.block_rows(); ++r) {
+        const Eigen::Index g = global_of[r];
+        EXPECT_EQ(part.row_ptr()[r + 1] - part.row_ptr()[r], whole.row_ptr()[g + 1] - whole.row_ptr()[g]) << r;
+        for (auto p = part.row_ptr()[r]; p < part.row_ptr()[r + 1]; ++p) {
+          const Eigen::Index col = global_of[part.col_index()[p]];
+          ASSERT_TRUE(whole.contains(g, col)) << r;
+          ASSERT_TRUE(Eigen::Matrix4d(part.block_at(p)) == Eigen::Matrix4d(whole.block(g, col)))
+              << "row cell " << g << " column cell " << col;
+        }
+      }
+      // contract breaches: a selected cell out of order, a column beyond cols
+      auto bad = num;
+      std::swap(bad.local[m.cell_offset(static_cast<int>(sel))], bad.local[m.cell_offset(static_cast<int>(sel)) + 1]);
+      EXPECT_TRUE(contains(input_error_of([&] { assemble_jacobian<2>(m, view, kind, part, &bad); }), "numbering"));
+      bad = num;
+      bad.cols = num.rows;
+      EXPECT_TRUE(contains(input_error_of([&] { assemble_jacobian<2>(m, view, kind, part, &bad); }), "numbering"));
+    }
 }

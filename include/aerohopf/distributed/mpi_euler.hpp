@@ -1,16 +1,18 @@
 #pragma once
-// The Euler residual on a grid partitioned over MPI ranks (optional component: needs <mpi.h>,
-// CMake target aerohopf::mpi). Each rank owns whole blocks (partition.hpp) and holds its cells'
-// state as a local vector; a residual evaluation sends the cells other ranks' halos read
-// (halo_plan: nonblocking point-to-point, one message per neighbouring rank), evaluates the
-// owned blocks (euler_model::residual_of_blocks) and returns the owned rows. Each value equals
-// the serial residual's bitwise: the same operations in the same order per cell.
+// The Euler residual, its Jacobians and their products on a grid partitioned over MPI ranks
+// (optional component: needs <mpi.h>; link MPI yourself, e.g. CMake's MPI::MPI_CXX). Each rank
+// owns whole blocks (partition.hpp) and holds its cells' values as a local vector. The cells
+// other ranks' halos read are sent by nonblocking point-to-point messages, one per neighbouring
+// rank (halo_plan); then the rank evaluates its blocks (euler_model::residual_of_blocks,
+// flow::assemble_jacobian with a numbering): its rows, bitwise the serial ones (the same
+// operations in the same order per cell). Jacobian rows are numbered locally: the owned cells,
+// then the received ones by source rank, so a product A x needs x's received values only.
 //
 // Memory: the grid and its metrics are replicated on every rank, and each rank keeps two
 // full-length scratch vectors (the state: owned and received cells current, the rest the free
-// stream, never read; and the residual): 2 * 8 * 5 bytes per cell in 3D, 114 MB for 1.43
-// million cells. Local numbering of the halo cells (scratch of the owned and ghost cells only)
-// is the step that removes them.
+// stream, never read; and the residual) and the global-to-local map: 88 bytes per cell in 3D,
+// 126 MB for 1.43 million cells. A residual over the owned and received cells only is the step
+// that removes them.
 //
 // Errors are collective: a rank whose evaluation throws (a bad local size, a non-physical cell)
 // makes every rank throw, the failing rank its own error and the others an input_error naming
@@ -21,6 +23,8 @@
 #include <aerohopf/distributed/partition.hpp>
 #include <aerohopf/error.hpp>
 #include <aerohopf/flow/euler_model.hpp>
+#include <aerohopf/flow/jacobian.hpp>
+#include <aerohopf/linalg/block_sparse_matrix.hpp>
 
 #include <cstddef>
 #include <exception>
@@ -78,14 +82,28 @@ class distributed_euler {
               size);
       plan_ = make_halo_plan(model_, part, rank_);
     });
+    // local numbering: the owned cells in global order, then the received cells by source rank
+    numbering_.blocks = plan_.owned_blocks;
+    numbering_.local.assign(model_.n_cells(), -1);
+    Eigen::Index k = 0;
+    for (const auto& [first, last] : plan_.owned)
+      for (std::size_t c = first; c < last; ++c) numbering_.local[c] = k++;
+    numbering_.rows = k;
+    ghost_offset_.assign(plan_.ranks + 1, 0);
+    for (int q = 0; q < plan_.ranks; ++q) {
+      ghost_offset_[q] = k;
+      for (const std::size_t c : plan_.recv[q]) numbering_.local[c] = k++;
+    }
+    ghost_offset_[plan_.ranks] = k;
+    numbering_.cols = k;
+    send_local_.resize(plan_.ranks);
+    send_.resize(plan_.ranks);
+    for (int q = 0; q < plan_.ranks; ++q) {
+      for (const std::size_t c : plan_.send[q]) send_local_[q].push_back(numbering_.local[c]);
+      send_[q].resize(plan_.send[q].size() * nv);
+    }
     scratch_ = model_.template free_stream_vector<double>();
     residual_.setZero(model_.size());
-    send_.resize(plan_.ranks);
-    recv_.resize(plan_.ranks);
-    for (int q = 0; q < plan_.ranks; ++q) {
-      send_[q].resize(plan_.send[q].size() * nv);
-      recv_[q].resize(plan_.recv[q].size() * nv);
-    }
   }
 
   const halo_plan& plan() const { return plan_; }
@@ -131,48 +149,69 @@ class distributed_euler {
     return global;
   }
 
-  /// Sends the cells other ranks read and receives those this rank reads into the full-length
-  /// scratch, with this rank's own cells from `local` (collective).
-  void exchange(const vec<double>& local) {
-    internal::collective(comm_, "distributed_euler::exchange",
-                         [&] { require_size(local.size(), local_size(), "distributed_euler::exchange", "local state"); });
-    Eigen::Index k = 0;
-    for (const auto& [a, b] : plan_.owned) {
-      const auto n = static_cast<Eigen::Index>((b - a) * nv);
-      scratch_.segment(static_cast<Eigen::Index>(a * nv), n) = local.segment(k, n);
-      k += n;
-    }
+  /// Local numbering of this rank's Jacobian rows and columns (flow::jacobian_numbering): the
+  /// owned cells, then the received cells by source rank.
+  const flow::jacobian_numbering& numbering() const { return numbering_; }
+
+  /// `local` followed by the values of the received cells (numbering().cols cells): sends the
+  /// cells other ranks read and receives those this rank reads (collective).
+  vec<double> with_ghosts(const vec<double>& local) {
+    internal::collective(comm_, "distributed_euler::with_ghosts", [&] {
+      require_size(local.size(), local_size(), "distributed_euler::with_ghosts", "local vector");
+    });
+    vec<double> ext(numbering_.cols * nv);
+    ext.head(local.size()) = local;
     std::vector<MPI_Request> req;
     req.reserve(2 * plan_.ranks);
     constexpr int tag = 7301;
     for (int q = 0; q < plan_.ranks; ++q) {
-      if (plan_.recv[q].empty()) continue;
+      const auto n = (ghost_offset_[q + 1] - ghost_offset_[q]) * nv;
+      if (n == 0) continue;
       req.emplace_back();
-      internal::check_mpi(MPI_Irecv(recv_[q].data(), static_cast<int>(recv_[q].size()), MPI_DOUBLE, q, tag, comm_,
-                                    &req.back()),
+      internal::check_mpi(MPI_Irecv(ext.data() + ghost_offset_[q] * nv, static_cast<int>(n), MPI_DOUBLE, q, tag,
+                                    comm_, &req.back()),
                           "MPI_Irecv");
     }
     for (int q = 0; q < plan_.ranks; ++q) {
-      if (plan_.send[q].empty()) continue;
+      if (send_local_[q].empty()) continue;
       std::size_t i = 0;
-      for (const std::size_t c : plan_.send[q])
-        for (int v = 0; v < nv; ++v) send_[q][i++] = scratch_[static_cast<Eigen::Index>(c * nv + v)];
+      for (const Eigen::Index c : send_local_[q])
+        for (int v = 0; v < nv; ++v) send_[q][i++] = local[c * nv + v];
       req.emplace_back();
       internal::check_mpi(MPI_Isend(send_[q].data(), static_cast<int>(send_[q].size()), MPI_DOUBLE, q, tag, comm_,
                                     &req.back()),
                           "MPI_Isend");
     }
     internal::check_mpi(MPI_Waitall(static_cast<int>(req.size()), req.data(), MPI_STATUSES_IGNORE), "MPI_Waitall");
-    for (int q = 0; q < plan_.ranks; ++q) {
-      std::size_t i = 0;
-      for (const std::size_t c : plan_.recv[q])
-        for (int v = 0; v < nv; ++v) scratch_[static_cast<Eigen::Index>(c * nv + v)] = recv_[q][i++];
-    }
+    return ext;
+  }
+
+  /// dR/dw in this rank's rows at the distributed state `local`, columns in numbering() (each
+  /// entry bitwise the serial Jacobian's; the pattern is set on first use and reused).
+  /// Collective.
+  void jacobian(const vec<double>& local, flow::jacobian_kind kind, block_sparse_matrix<double, nv>& a) {
+    load_state(local);
+    internal::collective(comm_, "distributed_euler::jacobian",
+                         [&] { flow::assemble_jacobian<Dim>(model_, scratch_, kind, a, &numbering_); });
+  }
+
+  /// y = A x for a matrix of this rank's rows in numbering() (jacobian()) and x distributed as
+  /// states are (collective: the ghost values of x are exchanged).
+  vec<double> multiply(const block_sparse_matrix<double, nv>& a, const vec<double>& x) {
+    const vec<double> ext = with_ghosts(x);
+    vec<double> y(local_size());
+    internal::collective(comm_, "distributed_euler::multiply", [&] {
+      require(a.block_rows() == numbering_.rows && a.block_cols() == numbering_.cols,
+              "distributed_euler::multiply: the matrix has ", a.block_rows(), " x ", a.block_cols(),
+              " blocks, this rank's numbering ", numbering_.rows, " x ", numbering_.cols);
+      a.multiply(ext, y);
+    });
+    return y;
   }
 
   /// R in this rank's cells at the distributed state whose local part is `local` (collective).
   vec<double> residual(const vec<double>& local) {
-    exchange(local);
+    load_state(local);
     vec<double> r(local_size());
     internal::collective(comm_, "distributed_euler::residual", [&] {
       model_.template residual_of_blocks<double>(model_.metrics(), scratch_.data(), residual_.data(),
@@ -188,13 +227,27 @@ class distributed_euler {
   }
 
  private:
+  /// The full-length scratch holds `local` and the received cells (collective).
+  void load_state(const vec<double>& local) {
+    const vec<double> ext = with_ghosts(local);
+    for (const auto& [first, last] : plan_.owned)
+      for (std::size_t c = first; c < last; ++c)
+        scratch_.segment(static_cast<Eigen::Index>(c * nv), nv) = ext.segment(numbering_.local[c] * nv, nv);
+    for (int q = 0; q < plan_.ranks; ++q)
+      for (const std::size_t c : plan_.recv[q])
+        scratch_.segment(static_cast<Eigen::Index>(c * nv), nv) = ext.segment(numbering_.local[c] * nv, nv);
+  }
+
   const flow::euler_model<Dim>& model_;
   MPI_Comm comm_;
   int rank_ = 0;
   block_partition part_;
   halo_plan plan_;
+  flow::jacobian_numbering numbering_;
+  std::vector<Eigen::Index> ghost_offset_;            // first local column of each source rank's cells
+  std::vector<std::vector<Eigen::Index>> send_local_;  // local cells each rank reads here
+  std::vector<std::vector<double>> send_;
   vec<double> scratch_, residual_;  // full length (see the memory note above)
-  std::vector<std::vector<double>> send_, recv_;
 };
 
 }  // namespace aerohopf::distributed

@@ -28,14 +28,27 @@ namespace aerohopf::flow {
 
 enum class jacobian_kind { exact, modified_order };
 
+/// The rows and columns of a Jacobian restricted to some blocks (one rank's part of a
+/// partitioned grid, distributed/mpi_euler.hpp): the rows are the cells of the selected blocks,
+/// in global order, and these cells are also columns 0 .. rows - 1 in that order; local[c] is the
+/// column of global cell c (the others read: rows .. cols - 1; -1: c is no column here). Without
+/// a numbering, the Jacobian is the whole square one in global numbering.
+struct jacobian_numbering {
+  std::vector<char> blocks;          // one entry per block: rows of this block are assembled
+  std::vector<Eigen::Index> local;   // n_cells() entries
+  Eigen::Index rows = 0, cols = 0;   // block rows and block columns
+};
+
 namespace internal {
 
-/// Calls fn(b, d, k, f, cm, c0) for every face of every block: k = face index among the faces
-/// normal to d, f = its position along d, cm/c0 the padded cells on its -/+ side.
+/// Calls fn(b, d, k, f, cm, c0) for every face of every block (of the selected blocks only if
+/// `blocks` is given): k = face index among the faces normal to d, f = its position along d,
+/// cm/c0 the padded cells on its -/+ side.
 template <int Dim, class Fn>
-void for_each_face(const euler_model<Dim>& m, Fn&& fn) {
+void for_each_face(const euler_model<Dim>& m, Fn&& fn, const std::vector<char>* blocks = nullptr) {
   const auto& met = m.metrics();
   for (int b = 0; b < static_cast<int>(met.blocks.size()); ++b) {
+    if (blocks && !(*blocks)[b]) continue;
     const auto& mb = met.blocks[b];
     for (int d = 0; d < Dim; ++d) {
       const auto fd = mb.face_dims(d);
@@ -76,41 +89,72 @@ std::vector<Eigen::Index> columns_of(const euler_model<Dim>& m, int b, std::size
 
 /// Block pattern (cell row, cell column) of the chosen Jacobian.
 template <int Dim>
-std::vector<std::pair<Eigen::Index, Eigen::Index>> jacobian_pattern(const euler_model<Dim>& m, jacobian_kind kind) {
+std::vector<std::pair<Eigen::Index, Eigen::Index>> jacobian_pattern(const euler_model<Dim>& m, jacobian_kind kind,
+                                                                    const jacobian_numbering* num = nullptr) {
   std::vector<std::pair<Eigen::Index, Eigen::Index>> pairs;
   const bool wide = kind == jacobian_kind::exact && m.options().order == 2;
-  for (std::size_t c = 0; c < m.n_cells(); ++c) pairs.emplace_back(c, c);
-  internal::for_each_face<Dim>(m, [&](int b, int d, std::size_t, int f, std::size_t cm, std::size_t c0) {
-    const std::size_t s = m.stride(b, d);
-    std::vector<std::size_t> sten{cm, c0};
-    if (wide) sten = {cm - s, cm, c0, c0 + s};
-    const int n = m.metrics().blocks[b].cells[d];
-    for (std::size_t q : sten) {
-      for (const auto col : internal::columns_of<Dim>(m, b, q)) {
-        if (f > 0) pairs.emplace_back(internal::column_of<Dim>(m, b, cm), col);
-        if (f < n) pairs.emplace_back(internal::column_of<Dim>(m, b, c0), col);
-      }
-    }
-  });
+  const auto to = [&](Eigen::Index c) { return num ? num->local[static_cast<std::size_t>(c)] : c; };
+  for (std::size_t b = 0; b < m.grid().topology.cells.size(); ++b) {
+    if (num && !num->blocks[b]) continue;
+    for (std::size_t c = m.cell_offset(static_cast<int>(b)); c < m.cell_offset(static_cast<int>(b) + 1); ++c)
+      pairs.emplace_back(to(static_cast<Eigen::Index>(c)), to(static_cast<Eigen::Index>(c)));
+  }
+  internal::for_each_face<Dim>(
+      m,
+      [&](int b, int d, std::size_t, int f, std::size_t cm, std::size_t c0) {
+        const std::size_t s = m.stride(b, d);
+        std::vector<std::size_t> sten{cm, c0};
+        if (wide) sten = {cm - s, cm, c0, c0 + s};
+        const int n = m.metrics().blocks[b].cells[d];
+        for (std::size_t q : sten) {
+          for (const auto col : internal::columns_of<Dim>(m, b, q)) {
+            if (f > 0) pairs.emplace_back(to(internal::column_of<Dim>(m, b, cm)), to(col));
+            if (f < n) pairs.emplace_back(to(internal::column_of<Dim>(m, b, c0)), to(col));
+          }
+        }
+      },
+      num ? &num->blocks : nullptr);
   return pairs;
 }
 
 /// Assembles dR/dw (R = dw/dt) at state w into a (pattern set here if a is empty or has the
 /// wrong size, otherwise reused with set_zero()). The size and the physical state of w are
 /// checked before a is touched.
+///
+/// With a numbering `num`, only the rows of the selected blocks are assembled, in its local rows
+/// and columns (each entry bitwise the whole Jacobian's); w is then read only at the cells of
+/// those blocks and at the donors of their halos (euler_model::residual_of_blocks).
 template <int Dim>
 void assemble_jacobian(const euler_model<Dim>& m, const vec<double>& w, jacobian_kind kind,
-                       block_sparse_matrix<double, Dim + 2>& a) {
+                       block_sparse_matrix<double, Dim + 2>& a, const jacobian_numbering* num = nullptr) {
   constexpr int nv = Dim + 2;
   using block = Eigen::Matrix<double, nv, nv>;
   require_size(w.size(), m.size(), "assemble_jacobian", "state");
-  m.template require_physical<double>(w.data(), "assemble_jacobian");
   const auto ncell = static_cast<Eigen::Index>(m.n_cells());
-  if (a.block_rows() != ncell) a.set_pattern(ncell, ncell, jacobian_pattern<Dim>(m, kind));
+  if (num) {
+    require_size(num->blocks.size(), m.grid().topology.cells.size(), "assemble_jacobian", "numbering's blocks");
+    require_size(num->local.size(), m.n_cells(), "assemble_jacobian", "numbering's columns");
+    Eigen::Index row = 0;
+    for (std::size_t b = 0; b < num->blocks.size(); ++b)
+      for (std::size_t c = m.cell_offset(static_cast<int>(b)); c < m.cell_offset(static_cast<int>(b) + 1); ++c) {
+        const Eigen::Index l = num->local[c];
+        require(num->blocks[b] ? l == row++ : l < 0 || (l >= num->rows && l < num->cols), "assemble_jacobian: the "
+                "numbering gives cell ", c, " column ", l, " (selected blocks' cells: 0 ..", num->rows - 1,
+                " in order; others: ", num->rows, " .. ", num->cols - 1, " or -1)");
+      }
+    require(row == num->rows, "assemble_jacobian: the numbering has ", num->rows, " rows, the selected blocks ", row,
+            " cells");
+    m.template require_physical<double>(w.data(), num->blocks, "assemble_jacobian");
+  } else {
+    m.template require_physical<double>(w.data(), "assemble_jacobian");
+  }
+  const Eigen::Index nrow = num ? num->rows : ncell, ncol = num ? num->cols : ncell;
+  if (a.block_rows() != nrow || a.block_cols() != ncol) a.set_pattern(nrow, ncol, jacobian_pattern<Dim>(m, kind, num));
   a.set_zero(false);
+  const auto to = [&](Eigen::Index c) { return num ? num->local[static_cast<std::size_t>(c)] : c; };
   const auto& met = m.metrics();
   std::vector<std::vector<state<double, Dim>>> padded;
-  m.template fill_padded<double>(met, w.data(), padded);
+  m.template fill_padded<double>(met, w.data(), padded, num ? &num->blocks : nullptr);
 
   // dg/dw_donor of every halo cell (identity across interfaces): one jet pass per donor, the nv
   // directions being the donor's nv unknowns.
@@ -119,6 +163,7 @@ void assemble_jacobian(const euler_model<Dim>& m, const vec<double>& w, jacobian
   std::vector<block> dhalo(m.halos().size()), dhalo2(m.halos().size());
   for (std::size_t k = 0; k < m.halos().size(); ++k) {
     const auto& h = m.halos()[k];
+    if (num && !num->blocks[h.block]) continue;
     if (h.kind == boundary_kind::interface) {
       dhalo[k].setIdentity();
       continue;
@@ -145,13 +190,14 @@ void assemble_jacobian(const euler_model<Dim>& m, const vec<double>& w, jacobian
   auto add_column = [&](int b, std::size_t padded_cell, Eigen::Index row, const block& d, double scale) {
     const long long o = m.padded_owner(b, padded_cell);
     if (o >= 0) {
-      a.block(row, static_cast<Eigen::Index>(o)) += scale * d;
+      a.block(row, to(static_cast<Eigen::Index>(o))) += scale * d;
     } else {
       const auto hk = static_cast<std::size_t>(-1 - o);
       const auto& h = m.halos()[hk];
-      a.block(row, static_cast<Eigen::Index>(m.cell_offset(h.donor_block) + h.donor)) += scale * (d * dhalo[hk]);
+      a.block(row, to(static_cast<Eigen::Index>(m.cell_offset(h.donor_block) + h.donor))) += scale * (d * dhalo[hk]);
       if (h.donor2 != h.donor)
-        a.block(row, static_cast<Eigen::Index>(m.cell_offset(h.donor_block) + h.donor2)) += scale * (d * dhalo2[hk]);
+        a.block(row, to(static_cast<Eigen::Index>(m.cell_offset(h.donor_block) + h.donor2))) +=
+            scale * (d * dhalo2[hk]);
     }
   };
   const bool exact2 = kind == jacobian_kind::exact && m.options().order == 2;
@@ -163,8 +209,8 @@ void assemble_jacobian(const euler_model<Dim>& m, const vec<double>& w, jacobian
     const std::size_t s = m.stride(b, d);
     const auto& pb = padded[b];
     const int n = mb.cells[d];
-    const Eigen::Index row_m = f > 0 ? internal::column_of<Dim>(m, b, cm) : -1;
-    const Eigen::Index row_p = f < n ? internal::column_of<Dim>(m, b, c0) : -1;
+    const Eigen::Index row_m = f > 0 ? to(internal::column_of<Dim>(m, b, cm)) : -1;
+    const Eigen::Index row_p = f < n ? to(internal::column_of<Dim>(m, b, c0)) : -1;
     const double vol_m = f > 0 ? mb.volume[m.interior_index(b, cm)] : 1.0;
     const double vol_p = f < n ? mb.volume[m.interior_index(b, c0)] : 1.0;
     auto scatter = [&](std::size_t cell, const block& dflux) {
@@ -224,7 +270,7 @@ void assemble_jacobian(const euler_model<Dim>& m, const vec<double>& w, jacobian
       if (row_m >= 0) a.block(row_m, row_m).diagonal().array() -= qd / vol_m;
       if (row_p >= 0) a.block(row_p, row_p).diagonal().array() += qd / vol_p;
     }
-  });
+  }, num ? &num->blocks : nullptr);
 }
 
 }  // namespace aerohopf::flow
