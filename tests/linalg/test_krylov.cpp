@@ -108,6 +108,34 @@ TEST(Krylov, AllMethodsRealBlock4) { check_all_methods<double, 4>(0.0, 4); }
 TEST(Krylov, AllMethodsComplexShiftedBlock5) { check_all_methods<cd, 5>(0.8, 5); }
 TEST(Krylov, AllMethodsComplexShiftedDynamic3) { check_all_methods<cd, Eigen::Dynamic>(1.5, 3); }
 
+// A distributed operator (global_sum: distributed/mpi_euler.hpp) on one process: GMRES forms
+// every inner product and norm through global_sum, with the same bits as the local path.
+TEST(Krylov, DistributedOperatorOnOneProcessGivesTheLocalIterates) {
+  const auto a = convection_diffusion<double, 4>(12, 10, 4, 2.0, 1.0, 3);
+  struct one_process {
+    const block_sparse_matrix<double, 4>* a;
+    mutable int sums = 0;
+    Eigen::Index rows() const { return a->rows(); }
+    void apply(const vec<double>& x, vec<double>& y) const { a->multiply(x, y); }
+    void global_sum(double*, int) const { ++sums; }
+  };
+  static_assert(distributed_operator<one_process, double>);
+  const one_process d{&a};
+  block_ilu<double, 4> ilu;
+  ilu.compute(a);
+  const vec<double> b = vec<double>::Random(a.rows());
+  krylov_options o;
+  o.relative_tolerance = 1e-10;
+  o.restart = 20;
+  vec<double> x_local, x_dist;
+  const auto local = gmres(a, ilu, b, x_local, o);
+  const auto dist = gmres(d, ilu, b, x_dist, o);
+  EXPECT_TRUE(local.converged && dist.converged);
+  EXPECT_EQ(x_local, x_dist);
+  EXPECT_EQ(local.residual_history, dist.residual_history);
+  EXPECT_GE(d.sums, 2 * dist.iterations);  // at least the projections and the norm per step
+}
+
 TEST(Krylov, GcrAndGmresShareTheMinimalResidualHistory) {
   const auto a = shifted(convection_diffusion<double, 4>(8, 8, 4, 1.0, 0.5, 4), cd(0, 0.5));
   const vec<cd> b = vec<cd>::Random(a.rows());

@@ -250,4 +250,49 @@ class distributed_euler {
   vec<double> scratch_, residual_;  // full length (see the memory note above)
 };
 
+/// A matrix of one rank's rows in distributed_euler's numbering (distributed_euler::jacobian, or
+/// any matrix of that pattern) as a distributed linear operator (linalg/operator.hpp): y = A x
+/// with the ghost values of x exchanged, inner products summed over the ranks, so that gmres
+/// runs the same iteration on every rank. `d` and `a` must outlive it.
+template <int Dim>
+class distributed_matrix_operator {
+ public:
+  distributed_matrix_operator(distributed_euler<Dim>& d, const block_sparse_matrix<double, Dim + 2>& a, MPI_Comm comm)
+      : d_(&d), a_(&a), comm_(comm) {}
+  Eigen::Index rows() const { return d_->local_size(); }
+  Eigen::Index cols() const { return d_->local_size(); }
+  void apply(const vec<double>& x, vec<double>& y) const { y = d_->multiply(*a_, x); }
+  void global_sum(double* p, int n) const {
+    internal::check_mpi(MPI_Allreduce(MPI_IN_PLACE, p, n, MPI_DOUBLE, MPI_SUM, comm_), "MPI_Allreduce");
+  }
+
+ private:
+  distributed_euler<Dim>* d_;
+  const block_sparse_matrix<double, Dim + 2>* a_;
+  MPI_Comm comm_;
+};
+
+/// The part of a rank's rows in its own cells (columns 0 .. block_rows - 1 of the local
+/// numbering), square: the matrix of the block-Jacobi preconditioner, whose BILU(k) per rank
+/// drops the couplings across ranks (the original's preconditioner "method 3", additive Schwarz
+/// without overlap).
+template <int B>
+block_sparse_matrix<double, B> owned_part(const block_sparse_matrix<double, B>& a) {
+  using storage_index = typename block_sparse_matrix<double, B>::storage_index;
+  const Eigen::Index n = a.block_rows();
+  std::vector<storage_index> ptr(n + 1, 0), col;
+  for (Eigen::Index i = 0; i < n; ++i) {
+    for (auto p = a.row_ptr()[i]; p < a.row_ptr()[i + 1]; ++p)
+      if (a.col_index()[p] < n) col.push_back(a.col_index()[p]);
+    ptr[i + 1] = static_cast<storage_index>(col.size());
+  }
+  block_sparse_matrix<double, B> o;
+  o.set_pattern_csr(n, n, ptr, col);
+  o.set_zero(false);
+  for (Eigen::Index i = 0; i < n; ++i)
+    for (auto p = a.row_ptr()[i]; p < a.row_ptr()[i + 1]; ++p)
+      if (a.col_index()[p] < n) o.block(i, a.col_index()[p]) = a.block_at(p);
+  return o;
+}
+
 }  // namespace aerohopf::distributed

@@ -13,6 +13,9 @@
 // A: any linear_operator (operator.hpp): block_sparse_matrix, Eigen matrix, lambda,
 // shifted_operator, bordered_operator. M: identity_preconditioner{}, block_ilu, ... .
 // Scalar: from b; complex scalars use the conjugating inner product <u, v> = sum conj(u_i) v_i.
+// Distributed: for an A with global_sum (distributed_operator, operator.hpp), b, x and M act on
+// this process's part, and GMRES sums every inner product and norm over the processes (the
+// other methods refuse such an A at compile time).
 // Convergence: ||b - A x|| <= max(relative_tolerance * ||b||, absolute_tolerance), judged on
 // the TRUE residual (recomputed at restarts and at the end; reported as relative_residual).
 // Failure is returned in the report (converged = false, reason); with throw_on_failure a
@@ -105,6 +108,25 @@ struct krylov_state {
 
   std::string where;  // "<context>: <method>"
 
+  /// Sums over the processes of a distributed operator (no-op otherwise).
+  template <class Derived>
+  void global_sum(Eigen::MatrixBase<Derived>& v) const {
+    if constexpr (distributed_operator<Op, S>) {
+      static_assert(Derived::InnerStrideAtCompileTime == 1, "global_sum: contiguous values");
+      a.global_sum(v.derived().data(), static_cast<int>(v.size()));
+    }
+  }
+  real global_sum(real v) const {
+    if constexpr (distributed_operator<Op, real>) a.global_sum(&v, 1);
+    return v;
+  }
+  /// ||v|| of the whole (distributed) vector: sqrt of the summed squares, bitwise v.norm() for a
+  /// local operator.
+  real norm(const vec<S>& v) const {
+    if constexpr (distributed_operator<Op, real>) return std::sqrt(global_sum(v.squaredNorm()));
+    else return v.norm();
+  }
+
   /// Checks everything the caller passed (x untouched until they pass); x empty = zero guess.
   krylov_state(const char* name, const Op& a_, const Pre& m_, const vec<S>& b_, vec<S>& x_, const krylov_options& o)
       : a(a_), m(m_), b(b_), x(x_), opt(o), where(concat(o.context, ": ", name)) {
@@ -118,7 +140,7 @@ struct krylov_state {
       require_size(x.size(), n, where, "initial guess");
       require_finite(x, where, "initial guess");
     }
-    rep.rhs_norm = static_cast<double>(b.norm());
+    rep.rhs_norm = static_cast<double>(norm(b));
     require(std::isfinite(rep.rhs_norm), where, ": right-hand side norm overflows (", rep.rhs_norm, ")");
     if (x.size() == 0) x = vec<S>::Zero(n);
     target = std::max(opt.relative_tolerance * rep.rhs_norm, opt.absolute_tolerance);
@@ -140,10 +162,10 @@ struct krylov_state {
   /// b = 0: x = 0 solves A x = b exactly for any A. Reports ||A x0|| as the initial residual.
   bool zero_rhs() const { return rep.rhs_norm == 0.0; }
   krylov_report zero_solution() {
-    if (!x.isZero(0.0)) {
+    if (norm(x) != real(0)) {
       vec<S> ax(b.size());
       op(x, ax);
-      rep.initial_residual = static_cast<double>(ax.norm());
+      rep.initial_residual = static_cast<double>(norm(ax));
     }
     x.setZero();
     record(rep.initial_residual);
@@ -156,7 +178,7 @@ struct krylov_state {
   double true_residual(vec<S>& r, vec<S>& tmp) {
     op(x, tmp);
     r = b - tmp;
-    return static_cast<double>(r.norm());
+    return static_cast<double>(norm(r));
   }
   void record(double rnorm) {
     if (opt.record_history) rep.residual_history.push_back(rnorm / scale());
@@ -219,16 +241,18 @@ krylov_report gmres(const Op& a, const Pre& m_pre, const vec<S>& b, vec<S>& x, c
          // over the basis instead of j+1 dot/axpy pairs
         const auto vj = v.leftCols(j + 1);
         auto hj = hc.head(j + 1);
-        const real before = opt.reorthogonalize ? w.norm() : real(0);
+        const real before = opt.reorthogonalize ? st.norm(w) : real(0);
         hj.noalias() = vj.adjoint() * w;
+        st.global_sum(hj);
         w.noalias() -= vj * hj;
-        hn = w.norm();
+        hn = st.norm(w);
         if (opt.reorthogonalize && !(hn > real(opt.reorthogonalization_threshold) * before)) {
           auto h2 = hc2.head(j + 1);
           h2.noalias() = vj.adjoint() * w;
+          st.global_sum(h2);
           w.noalias() -= vj * h2;
           hj += h2;
-          hn = w.norm();
+          hn = st.norm(w);
         }
         h.col(j).head(j + 1) = hj;
       }
@@ -286,6 +310,7 @@ krylov_report gmres(const Op& a, const Pre& m_pre, const vec<S>& b, vec<S>& x, c
 /// r -= <c_j, r> c_j. One operator product per step; 2m stored vectors.
 template <class S, class Op, class Pre>
 krylov_report gcr(const Op& a, const Pre& m_pre, const vec<S>& b, vec<S>& x, const krylov_options& opt = {}) {
+  static_assert(!distributed_operator<Op, S>, "gcr: distributed operators are solved by gmres");
   internal::krylov_state<S, Op, Pre> st("GCR", a, m_pre, b, x, opt);
   if (st.zero_rhs()) return st.zero_solution();
   using real = real_of_t<S>;
@@ -334,6 +359,7 @@ krylov_report gcr(const Op& a, const Pre& m_pre, const vec<S>& b, vec<S>& x, con
 /// Right-preconditioned BiCGSTAB (van der Vorst); shadow residual = initial residual.
 template <class S, class Op, class Pre>
 krylov_report bicgstab(const Op& a, const Pre& m_pre, const vec<S>& b, vec<S>& x, const krylov_options& opt = {}) {
+  static_assert(!distributed_operator<Op, S>, "bicgstab: distributed operators are solved by gmres");
   internal::krylov_state<S, Op, Pre> st("BiCGSTAB", a, m_pre, b, x, opt);
   if (st.zero_rhs()) return st.zero_solution();
   const Eigen::Index n = b.size();
@@ -400,6 +426,7 @@ krylov_report bicgstab(const Op& a, const Pre& m_pre, const vec<S>& b, vec<S>& x
 /// QMR bound tau sqrt(m+1) is the stopping estimate, confirmed on the true residual.
 template <class S, class Op, class Pre>
 krylov_report tfqmr(const Op& a, const Pre& m_pre, const vec<S>& b, vec<S>& x, const krylov_options& opt = {}) {
+  static_assert(!distributed_operator<Op, S>, "tfqmr: distributed operators are solved by gmres");
   internal::krylov_state<S, Op, Pre> st("TFQMR", a, m_pre, b, x, opt);
   if (st.zero_rhs()) return st.zero_solution();
   using real = real_of_t<S>;

@@ -59,6 +59,13 @@ concept sized_cols = requires(const Op& op) {
   { op.cols() } -> std::convertible_to<Eigen::Index>;
 };
 
+/// An operator on a vector distributed over processes (distributed/mpi_euler.hpp): each process
+/// holds its part, and op.global_sum(p, n) replaces the n partial sums at p by their sums over
+/// all processes (MPI_Allreduce). The Krylov methods form every inner product and norm through
+/// it, so their iterates are the same on every process.
+template <class Op, class S>
+concept distributed_operator = requires(const Op& op, S* p, int n) { op.global_sum(p, n); };
+
 /// Throws input_error unless op (where it reports its size) maps vectors of n entries to
 /// vectors of n entries: "<where>: <what> (rows) has .. entries, expected n". No-op for an
 /// operator that does not know its size (a lambda, identity_preconditioner).
