@@ -1,6 +1,7 @@
 #pragma once
 // The Euler residual, its Jacobians and their products on a grid partitioned over MPI ranks
-// (optional component: needs <mpi.h>; link MPI yourself, e.g. CMake's MPI::MPI_CXX). Each rank
+// (optional component: needs <mpi.h>; CMake target aerohopf::mpi, find_package(aerohopf CONFIG
+// COMPONENTS mpi)). Each rank
 // owns whole blocks (partition.hpp) and holds its cells' values as a local vector. The cells
 // other ranks' halos read are sent by nonblocking point-to-point messages, one per neighbouring
 // rank (halo_plan); then the rank evaluates its blocks (euler_model::residual_of_blocks,
