@@ -1,12 +1,11 @@
 #pragma once
 // The Euler residual, its Jacobians and their products on a grid partitioned over MPI ranks
-// (optional component: needs <mpi.h>; CMake target aerohopf::mpi, find_package(aerohopf CONFIG
-// COMPONENTS mpi)). Each rank
-// owns whole blocks (partition.hpp) and holds its cells' values as a local vector. The cells
-// other ranks' halos read are sent by nonblocking point-to-point messages, one per neighbouring
-// rank (halo_plan); then the rank evaluates its blocks (euler_model::residual_of_blocks,
-// flow::assemble_jacobian with a numbering): its rows, bitwise the serial ones (the same
-// operations in the same order per cell). Jacobian rows are numbered locally: the owned cells,
+// (optional component: needs <mpi.h>; CMake target aerohopf::mpi, from find_package(aerohopf
+// CONFIG COMPONENTS mpi)). Each rank owns whole blocks (partition.hpp) and holds its cells'
+// values as a local vector. The cells other ranks' halos read are sent by nonblocking
+// point-to-point messages, one per neighbouring rank (halo_plan); then the rank evaluates its
+// blocks (euler_model::residual_of_blocks, flow::assemble_jacobian with a numbering): its rows,
+// bitwise the serial ones (the same operations in the same order per cell). Jacobian rows are numbered locally: the owned cells,
 // then the received ones by source rank, so a product A x needs x's received values only.
 //
 // Memory: the grid and its metrics are replicated on every rank, and each rank keeps two
