@@ -2,7 +2,8 @@
 // time assignment and its refusals; send and receive lists that mirror each other; and, the
 // plan's real test, every rank's residual from its owned cells and received cells alone (all
 // other cells NaN) equals the serial residual bitwise (euler_model::residual_of_blocks), on the
-// NACA 0012 C-grid (2D, three blocks) and a row of three boxes (3D), for 1, 2 and 3 ranks.
+// NACA 0012 C-grid (2D, three blocks), a row of three boxes (3D) and the tiny AGARD C-H grid (one
+// block, split_for_ranks), for 1, 2 and 3 ranks.
 #include <gtest/gtest.h>
 
 #include <aerohopf/distributed/partition.hpp>
@@ -12,6 +13,7 @@
 #include <vector>
 #include "support/error_messages.hpp"
 #include "support/partition_grids.hpp"
+#include "support/wing_cases.hpp"
 
 using namespace aerohopf;
 using namespace aerohopf::distributed;
@@ -91,10 +93,14 @@ void check_plans(const flow::euler_model<Dim>& m, int ranks) {
           ASSERT_EQ(r_view[k], -7.0) << "rank " << r << " wrote " << m.cell_name(c) << ", not its cell";
         }
       }
-    if (ranks > 1) EXPECT_GT(h.ghost_cells(), 0u) << "rank " << r;
+    if (ranks > 1) {
+      EXPECT_GT(h.ghost_cells(), 0u) << "rank " << r;
+    }
   }
   for (std::size_t c = 0; c < m.n_cells(); ++c) EXPECT_GE(owned_by[c], 0) << "cell " << c << " owned by no rank";
-  if (ranks == 1) EXPECT_EQ(plans[0].ghost_cells(), 0u);
+  if (ranks == 1) {
+    EXPECT_EQ(plans[0].ghost_cells(), 0u);
+  }
 }
 
 }  // namespace
@@ -141,4 +147,30 @@ TEST(partition, block_residual_checks_the_cells_it_reads) {
                          m.residual_of_blocks<double>(m.metrics(), w.data(), r.data(), std::vector<char>(2, 1));
                        }),
                        "block selection"));
+}
+
+// The single-block wing grid cut for 2, 3 and 4 ranks: balanced within the bound, the residual on
+// the cut grid the original's cell by cell, and every rank's plan complete (check_plans).
+TEST(partition, a_single_block_wing_is_split_for_the_ranks) {
+  const auto g = flow::wing_cgrid(test_support::agard(), test_support::tiny_wing_options());
+  const flow::free_stream fs{.mach = 0.9, .alpha_rad = 0.02};
+  const flow::euler_model<3> whole(g, fs);
+  const vec<double> w = test::perturbed_free_stream(whole, 21u);
+  const vec<double> r = whole.residual(w);
+  for (const int ranks : {2, 3, 4}) {
+    const auto s = split_for_ranks(g, ranks);
+    const flow::euler_model<3> m(s.grid, fs);
+    const auto p = partition_blocks(m, ranks);
+    EXPECT_LE(p.imbalance(), 1.1) << ranks << " ranks, " << s.grid.topology.cells.size() << " blocks";
+    vec<double> ws(w.size()), rs_expected(w.size());
+    for (std::size_t c = 0; c < s.original_cell.size(); ++c) {
+      ws.segment(static_cast<Eigen::Index>(5 * c), 5) = w.segment(static_cast<Eigen::Index>(5 * s.original_cell[c]), 5);
+      rs_expected.segment(static_cast<Eigen::Index>(5 * c), 5) =
+          r.segment(static_cast<Eigen::Index>(5 * s.original_cell[c]), 5);
+    }
+    EXPECT_LE((m.residual(ws) - rs_expected).cwiseAbs().maxCoeff(), 1e-13 * r.cwiseAbs().maxCoeff()) << ranks;
+    check_plans(m, ranks);
+  }
+  EXPECT_TRUE(contains(input_error_of([&] { split_for_ranks(g, 0); }), "0 ranks"));
+  EXPECT_TRUE(contains(input_error_of([&] { split_for_ranks(g, 2, 0.5); }), "max_imbalance"));
 }

@@ -1,18 +1,27 @@
 // Grids and metrics: the NACA C-grid generator (sizes, geometry, wall orthogonality, positive
 // volumes on all four levels), closed control volumes, total volume of a perturbed box against
 // its exact volume, and the geometric conservation law (sum of face speeds = dV/dt computed
-// independently by a central difference of volumes and by a taylor<> pass).
+// independently by a central difference of volumes and by a taylor<> pass); split_block against
+// the residual of the uncut grid.
 #include <gtest/gtest.h>
 
+#include <aerohopf/flow/euler_model.hpp>
 #include <aerohopf/flow/metrics.hpp>
 #include <aerohopf/flow/naca_cgrid.hpp>
 #include <aerohopf/scalar/taylor.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <random>
+#include <utility>
+#include <vector>
+#include "support/error_messages.hpp"
+#include "support/wing_cases.hpp"
 
 using namespace aerohopf;
 using namespace aerohopf::flow;
+using aerohopf::test::contains;
+using aerohopf::test::input_error_of;
 
 namespace {
 
@@ -258,4 +267,73 @@ TEST(metrics, geometric_conservation_law_3d_deforming) {
     EXPECT_NEAR(sum_q, mj.blocks[0].volume[k][1], 1e-13) << "cell " << k;
     EXPECT_NEAR(b.volume[k], mj.blocks[0].volume[k][0], 1e-15);
   }
+}
+
+// split_block: the residual on the grid with one block cut in two equals the original one cell
+// by cell (original_cell) at a random state, for cuts across interfaces, walls and far field:
+// the C-grid's aerofoil block along i (its ends are interfaces with the wake blocks) and along
+// j, a wake block along i (the wake cut, an interface with the other wake block with i
+// reversed, straddles the cut), and the tiny AGARD C-H grid (one block whose wake cut and
+// beyond-tip cut are interfaces with itself, i reversed) along i and along k, twice in a row.
+namespace {
+
+template <int Dim>
+void expect_same_residual(const multiblock_grid<Dim>& g, const split_grid<Dim>& s, const free_stream& fs) {
+  constexpr int nv = Dim + 2;
+  const euler_model<Dim> whole(g, fs), cut(s.grid, fs);
+  ASSERT_EQ(cut.n_cells(), whole.n_cells());
+  ASSERT_EQ(s.original_cell.size(), whole.n_cells());
+  std::mt19937 rng(17);
+  std::uniform_real_distribution<double> u(-0.05, 0.05);
+  vec<double> w = whole.free_stream_vector();
+  for (Eigen::Index k = 0; k < w.size(); ++k) w[k] *= 1.0 + u(rng);
+  vec<double> wc(w.size());
+  for (std::size_t c = 0; c < s.original_cell.size(); ++c)
+    wc.segment(static_cast<Eigen::Index>(c * nv), nv) = w.segment(static_cast<Eigen::Index>(s.original_cell[c] * nv), nv);
+  const vec<double> r = whole.residual(w), rc = cut.residual(wc);
+  double worst = 0;
+  for (std::size_t c = 0; c < s.original_cell.size(); ++c)
+    for (int v = 0; v < nv; ++v)
+      worst = std::max(worst, std::abs(rc[static_cast<Eigen::Index>(c * nv + v)] -
+                                       r[static_cast<Eigen::Index>(s.original_cell[c] * nv + v)]));
+  EXPECT_LE(worst, 1e-13 * r.cwiseAbs().maxCoeff());
+}
+
+}  // namespace
+
+TEST(split_block, residual_is_unchanged_by_cuts_2d) {
+  const auto g = coarsen(naca_cgrid(), 8);
+  const free_stream fs{.mach = 0.8, .alpha_rad = 0.03};
+  const auto& n = g.topology.cells;
+  for (const auto& [b, axis] : std::vector<std::pair<int, int>>{{1, 0}, {1, 1}, {0, 0}, {2, 0}}) {
+    SCOPED_TRACE(testing::Message() << "block " << b << " axis " << axis);
+    const auto s = split_block(g, b, axis, n[b][axis] / 2);
+    EXPECT_EQ(s.grid.topology.cells.size(), 4u);
+    expect_same_residual<2>(g, s, fs);
+  }
+}
+
+TEST(split_block, residual_is_unchanged_by_cuts_of_a_self_connected_wing_block_3d) {
+  const auto g = wing_cgrid(test_support::agard(), test_support::tiny_wing_options());
+  const free_stream fs{.mach = 0.9, .alpha_rad = 0.02};
+  const auto& n = g.topology.cells[0];
+  for (const int axis : {0, 2}) {
+    SCOPED_TRACE(testing::Message() << "axis " << axis);
+    const auto s = split_block(g, 0, axis, n[axis] / 2);
+    expect_same_residual<3>(g, s, fs);
+    // and the upper piece once more, along the other axis: original_cell composes
+    const int other = axis == 0 ? 2 : 0;
+    const auto s2 = split_block(s.grid, 1, other, s.grid.topology.cells[1][other] / 2);
+    split_grid<3> both{s2.grid, {}};
+    for (const std::size_t c : s2.original_cell) both.original_cell.push_back(s.original_cell[c]);
+    expect_same_residual<3>(g, both, fs);
+  }
+}
+
+TEST(split_block, bad_cuts_are_refused) {
+  const auto g = coarsen(naca_cgrid(), 8);
+  EXPECT_TRUE(contains(input_error_of([&] { split_block(g, 3, 0, 4); }), "block 3 of 3"));
+  EXPECT_TRUE(contains(input_error_of([&] { split_block(g, 0, 2, 4); }), "axis 2"));
+  EXPECT_TRUE(contains(input_error_of([&] { split_block(g, 0, 0, 1); }), "at least 2"));
+  EXPECT_TRUE(contains(input_error_of([&] { split_block(g, 0, 0, g.topology.cells[0][0] - 1); }), "at least 2"));
 }

@@ -4,7 +4,8 @@
 // rank computes every plan from the replicated grid, so the send lists need no communication,
 // and the plans are tested serially (tests/distributed/test_partition.cpp).
 //
-// Ownership is by whole blocks. A rank's residual in its cells reads, besides its own cells, only
+// Ownership is by whole blocks; split_for_ranks cuts large blocks (a wing grid is one block) so
+// that whole blocks balance. A rank's residual in its cells reads, besides its own cells, only
 // the donors of its blocks' halo cells (euler_model::halo_cell: interface halos copy cells of the
 // neighbouring block, wall and far-field halos are functions of the rank's own cells), so the
 // cells to receive are exactly the donors of those halos that lie in other ranks' blocks. The
@@ -51,8 +52,8 @@ inline block_partition partition_blocks(const std::vector<std::size_t>& block_ce
   require(ranks >= 1, "partition_blocks: ", ranks, " ranks (at least 1)");
   require(!block_cells.empty(), "partition_blocks: no blocks");
   require(static_cast<std::size_t>(ranks) <= block_cells.size(), "partition_blocks: ", ranks, " ranks for ",
-          block_cells.size(), " blocks: a rank would own no block (whole blocks are distributed; split the grid's "
-          "blocks first)");
+          block_cells.size(), " blocks: a rank would own no block (whole blocks are distributed; cut the grid's "
+          "blocks first: split_for_ranks)");
   for (std::size_t b = 0; b < block_cells.size(); ++b)
     require(block_cells[b] > 0, "partition_blocks: block ", b, " has no cells");
   std::vector<int> order(block_cells.size());
@@ -75,6 +76,36 @@ block_partition partition_blocks(const flow::euler_model<Dim>& m, int ranks) {
   std::vector<std::size_t> c(m.grid().topology.cells.size());
   for (std::size_t b = 0; b < c.size(); ++b) c[b] = m.cell_offset(static_cast<int>(b) + 1) - m.cell_offset(static_cast<int>(b));
   return partition_blocks(c, ranks);
+}
+
+/// A grid whose blocks whole-block partitioning can spread over `ranks` ranks within
+/// `max_imbalance` (largest rank's cells over the mean): the largest block is cut in half along
+/// its longest axis (flow::split_block) until partition_blocks reaches the bound, or the largest
+/// block has fewer than 4 cells along every axis (then the best grid so far is returned; check
+/// partition_blocks(...).imbalance()). A single-block wing grid is the case this is for.
+/// original_cell maps the result's cells to g's.
+template <int Dim>
+flow::split_grid<Dim> split_for_ranks(const flow::multiblock_grid<Dim>& g, int ranks, double max_imbalance = 1.1) {
+  require(ranks >= 1, "split_for_ranks: ", ranks, " ranks (at least 1)");
+  require(max_imbalance >= 1.0, "split_for_ranks: max_imbalance ", max_imbalance, " (at least 1)");
+  flow::split_grid<Dim> cur{g, {}};
+  std::size_t total = 0;
+  for (const auto& c : g.topology.cells) total += flow::product<Dim>(c);
+  cur.original_cell.resize(total);
+  std::iota(cur.original_cell.begin(), cur.original_cell.end(), std::size_t{0});
+  while (true) {
+    const auto& cells = cur.grid.topology.cells;
+    std::vector<std::size_t> n(cells.size());
+    for (std::size_t b = 0; b < n.size(); ++b) n[b] = flow::product<Dim>(cells[b]);
+    if (n.size() >= static_cast<std::size_t>(ranks) && partition_blocks(n, ranks).imbalance() <= max_imbalance) break;
+    const int big = static_cast<int>(std::max_element(n.begin(), n.end()) - n.begin());
+    const int axis = static_cast<int>(std::max_element(cells[big].begin(), cells[big].end()) - cells[big].begin());
+    if (cells[big][axis] < 4) break;
+    auto next = flow::split_block(cur.grid, big, axis, cells[big][axis] / 2);
+    for (auto& c : next.original_cell) c = cur.original_cell[c];
+    cur = std::move(next);
+  }
+  return cur;
 }
 
 /// One rank's view of a partition. Cells are the model's global cell numbers (state values

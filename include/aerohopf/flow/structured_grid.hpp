@@ -10,8 +10,10 @@
 // block face: a slip wall, a far field, or a point-matched interface with another block (or
 // the same block, e.g. a C-grid wake cut) with a signed axis transform as in CGNS.
 // Faces are numbered face = 2 * axis + side (side 0: index-min face, side 1: index-max face).
+#include <algorithm>
 #include <array>
 #include <cstddef>
+#include <cstdlib>
 #include <string>
 #include <vector>
 
@@ -195,6 +197,154 @@ multiblock_grid<Dim> coarsen(const multiblock_grid<Dim>& fine, int m) {
     }
   }
   return g;
+}
+
+/// A grid with one block cut in two (split_block) and where each of its cells came from.
+template <int Dim>
+struct split_grid {
+  multiblock_grid<Dim> grid;
+  std::vector<std::size_t> original_cell;  // for each cell of `grid` (blocks in order), its cell in the input
+};
+
+/// Cuts block b of g at cell index `at` along `axis`: cells [0, at) stay block b, cells [at, n)
+/// become a new last block, the two joined by a point-matched interface. Every patch is carried
+/// over: patches of b split where they straddle the cut (an interface's donor range with them),
+/// and interfaces whose donor range in b straddles it split likewise, so each halo cell of the
+/// result reads the same donor as before and the residual is the same (to the cell order,
+/// original_cell). Both pieces keep at least 2 cells along the axis (the MUSCL stencil and
+/// interface halos need 2).
+template <int Dim>
+split_grid<Dim> split_block(const multiblock_grid<Dim>& g, int b, int axis, int at) {
+  const int nb = static_cast<int>(g.topology.cells.size());
+  require(b >= 0 && b < nb, "split_block: block ", b, " of ", nb);
+  require(axis >= 0 && axis < Dim, "split_block: axis ", axis);
+  const auto cells = g.topology.cells[b];
+  require(at >= 2 && at <= cells[axis] - 2, "split_block: cut at cell ", at, " of block ", b, "'s ", cells[axis],
+          " cells along axis ", axis, " (each piece needs at least 2)");
+  const int nu = nb;  // index of the upper piece
+  split_grid<Dim> out;
+  auto& og = out.grid;
+  og.points = g.points;
+  og.topology.cells = g.topology.cells;
+  // points: lower [0, at], upper [at, n] along the axis (the cut plane in both)
+  {
+    const auto& src = g.points.blocks[b];
+    grid_block<double, Dim> lo, up;
+    lo.points = src.points;
+    lo.points[axis] = at + 1;
+    up.points = src.points;
+    up.points[axis] = src.points[axis] - at;
+    lo.x.resize(lo.n_points());
+    up.x.resize(up.n_points());
+    for (std::size_t k = 0; k < lo.x.size(); ++k) lo.x[k] = src.at(unravel<Dim>(k, lo.points));
+    for (std::size_t k = 0; k < up.x.size(); ++k) {
+      auto i = unravel<Dim>(k, up.points);
+      i[axis] += at;
+      up.x[k] = src.at(i);
+    }
+    og.points.blocks[b] = std::move(lo);
+    og.points.blocks.push_back(std::move(up));
+    og.topology.cells[b] = og.points.blocks[b].cells();
+    og.topology.cells.push_back(og.points.blocks[nu].cells());
+  }
+  // 1. patches ON block b: by the receiver's range along the axis
+  std::vector<boundary_patch<Dim>> pass1;
+  for (const auto& p : g.topology.patches) {
+    if (p.block != b) {
+      pass1.push_back(p);
+      continue;
+    }
+    if (p.face / 2 == axis) {
+      auto q = p;
+      if (p.face % 2 == 1) q.block = nu;
+      pass1.push_back(q);
+      continue;
+    }
+    const int lo = p.begin[axis], hi = p.end[axis];
+    for (const int piece : {0, 1}) {
+      const int a = piece == 0 ? lo : std::max(lo, at), c = piece == 0 ? std::min(hi, at) : hi;
+      if (a >= c) continue;
+      auto q = p;
+      q.block = piece == 0 ? b : nu;
+      q.begin[axis] = a - (piece ? at : 0);
+      q.end[axis] = c - (piece ? at : 0);
+      if (p.kind == boundary_kind::interface) {
+        const int tr = p.transform[axis], be = std::abs(tr) - 1;
+        const int d0 = a - lo, d1 = c - lo;  // the part's offsets along the receiver's axis
+        if (tr > 0) {
+          q.donor_begin[be] = p.donor_begin[be] + d0;
+          q.donor_end[be] = p.donor_begin[be] + d1;
+        } else {
+          q.donor_begin[be] = p.donor_end[be] - d1;
+          q.donor_end[be] = p.donor_end[be] - d0;
+        }
+      }
+      pass1.push_back(q);
+    }
+  }
+  // 2. interfaces whose DONOR is block b: by the donor range along the axis
+  for (const auto& p : pass1) {
+    if (p.kind != boundary_kind::interface || p.donor_block != b) {
+      og.topology.patches.push_back(p);
+      continue;
+    }
+    if (p.donor_face / 2 == axis) {
+      auto q = p;
+      if (p.donor_face % 2 == 1) q.donor_block = nu;
+      og.topology.patches.push_back(q);
+      continue;
+    }
+    int e = -1;  // the receiver's axis that runs along the donor's cut axis
+    for (int k = 0; k < Dim; ++k)
+      if (k != p.face / 2 && std::abs(p.transform[k]) - 1 == axis) e = k;
+    require(e >= 0, "split_block: interface patch of block ", p.block, " face ", p.face, " has no axis along the cut");
+    const bool forward = p.transform[e] > 0;
+    const int dlo = p.donor_begin[axis], dhi = p.donor_end[axis];
+    for (const int piece : {0, 1}) {
+      const int a = piece == 0 ? dlo : std::max(dlo, at), c = piece == 0 ? std::min(dhi, at) : dhi;
+      if (a >= c) continue;
+      auto q = p;
+      q.donor_block = piece == 0 ? b : nu;
+      q.donor_begin[axis] = a - (piece ? at : 0);
+      q.donor_end[axis] = c - (piece ? at : 0);
+      // receiver offsets of donor cells [a, c): forward delta = idx - dlo, reverse delta = dhi - 1 - idx
+      const int r0 = forward ? a - dlo : dhi - c, r1 = forward ? c - dlo : dhi - a;
+      q.begin[e] = p.begin[e] + r0;
+      q.end[e] = p.begin[e] + r1;
+      og.topology.patches.push_back(q);
+    }
+  }
+  // 3. the cut: lower's max face <-> upper's min face, axes aligned
+  for (const int piece : {0, 1}) {
+    boundary_patch<Dim> q;
+    q.block = piece == 0 ? b : nu;
+    q.face = 2 * axis + (piece == 0 ? 1 : 0);
+    q.kind = boundary_kind::interface;
+    q.donor_block = piece == 0 ? nu : b;
+    q.donor_face = 2 * axis + (piece == 0 ? 0 : 1);
+    const auto& own = og.topology.cells[q.block];
+    const auto& don = og.topology.cells[q.donor_block];
+    for (int k = 0; k < Dim; ++k) {
+      q.end[k] = own[k];
+      q.donor_end[k] = don[k];
+      q.transform[k] = k + 1;
+    }
+    og.topology.patches.push_back(q);
+  }
+  // where each cell came from: blocks before the new one keep their cells (b truncated), the new
+  // last block holds b's upper cells
+  std::vector<std::size_t> offset(nb + 1, 0);
+  for (int k = 0; k < nb; ++k) offset[k + 1] = offset[k] + product<Dim>(g.topology.cells[k]);
+  for (int k = 0; k <= nb; ++k) {
+    const int src = k == nu ? b : k;
+    const auto& oc = og.topology.cells[k];
+    for (std::size_t c = 0; c < product<Dim>(oc); ++c) {
+      auto i = unravel<Dim>(c, oc);
+      if (k == nu) i[axis] += at;
+      out.original_cell.push_back(offset[src] + linear_index<Dim>(i, g.topology.cells[src]));
+    }
+  }
+  return out;
 }
 
 /// Transfer of a cell-centred field with nv values per cell from a coarse grid to the grid
