@@ -216,12 +216,7 @@ class distributed_euler {
     internal::collective(comm_, "distributed_euler::residual", [&] {
       model_.template residual_of_blocks<double>(model_.metrics(), scratch_.data(), residual_.data(),
                                                  plan_.owned_blocks);
-      Eigen::Index k = 0;
-      for (const auto& [a, b] : plan_.owned) {
-        const auto n = static_cast<Eigen::Index>((b - a) * nv);
-        r.segment(k, n) = residual_.segment(static_cast<Eigen::Index>(a * nv), n);
-        k += n;
-      }
+      r = local_part(residual_);
     });
     return r;
   }

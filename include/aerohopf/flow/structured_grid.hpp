@@ -14,6 +14,7 @@
 #include <array>
 #include <cstddef>
 #include <cstdlib>
+#include <utility>
 #include <string>
 #include <vector>
 
@@ -247,6 +248,11 @@ split_grid<Dim> split_block(const multiblock_grid<Dim>& g, int b, int axis, int 
     og.topology.cells[b] = og.points.blocks[b].cells();
     og.topology.cells.push_back(og.points.blocks[nu].cells());
   }
+  // the part of a cell range [lo, hi) along the axis in piece 0 (below the cut) or 1 (above it,
+  // in the piece's own indices: shifted by -at), empty if first >= second
+  const auto part_of = [at](int piece, int lo, int hi) {
+    return piece == 0 ? std::pair{lo, std::min(hi, at)} : std::pair{std::max(lo, at) - at, hi - at};
+  };
   // 1. patches ON block b: by the receiver's range along the axis
   std::vector<boundary_patch<Dim>> pass1;
   for (const auto& p : g.topology.patches) {
@@ -262,15 +268,16 @@ split_grid<Dim> split_block(const multiblock_grid<Dim>& g, int b, int axis, int 
     }
     const int lo = p.begin[axis], hi = p.end[axis];
     for (const int piece : {0, 1}) {
-      const int a = piece == 0 ? lo : std::max(lo, at), c = piece == 0 ? std::min(hi, at) : hi;
+      const auto [a, c] = part_of(piece, lo, hi);
       if (a >= c) continue;
       auto q = p;
       q.block = piece == 0 ? b : nu;
-      q.begin[axis] = a - (piece ? at : 0);
-      q.end[axis] = c - (piece ? at : 0);
+      q.begin[axis] = a;
+      q.end[axis] = c;
       if (p.kind == boundary_kind::interface) {
         const int tr = p.transform[axis], be = std::abs(tr) - 1;
-        const int d0 = a - lo, d1 = c - lo;  // the part's offsets along the receiver's axis
+        const int shift = piece ? at : 0;
+        const int d0 = a + shift - lo, d1 = c + shift - lo;  // the part's offsets along the receiver's axis
         if (tr > 0) {
           q.donor_begin[be] = p.donor_begin[be] + d0;
           q.donor_end[be] = p.donor_begin[be] + d1;
@@ -301,13 +308,15 @@ split_grid<Dim> split_block(const multiblock_grid<Dim>& g, int b, int axis, int 
     const bool forward = p.transform[e] > 0;
     const int dlo = p.donor_begin[axis], dhi = p.donor_end[axis];
     for (const int piece : {0, 1}) {
-      const int a = piece == 0 ? dlo : std::max(dlo, at), c = piece == 0 ? std::min(dhi, at) : dhi;
-      if (a >= c) continue;
+      const auto [pa, pc] = part_of(piece, dlo, dhi);
+      if (pa >= pc) continue;
       auto q = p;
       q.donor_block = piece == 0 ? b : nu;
-      q.donor_begin[axis] = a - (piece ? at : 0);
-      q.donor_end[axis] = c - (piece ? at : 0);
-      // receiver offsets of donor cells [a, c): forward delta = idx - dlo, reverse delta = dhi - 1 - idx
+      q.donor_begin[axis] = pa;
+      q.donor_end[axis] = pc;
+      // receiver offsets of donor cells [a, c) (uncut indices): forward delta = idx - dlo,
+      // reverse delta = dhi - 1 - idx
+      const int a = pa + (piece ? at : 0), c = pc + (piece ? at : 0);
       const int r0 = forward ? a - dlo : dhi - c, r1 = forward ? c - dlo : dhi - a;
       q.begin[e] = p.begin[e] + r0;
       q.end[e] = p.begin[e] + r1;
