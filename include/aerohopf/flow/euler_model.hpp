@@ -33,7 +33,6 @@
 #include <cmath>
 #include <numbers>
 #include <optional>
-#include <sstream>
 #include <string>
 #include <string_view>
 #include <vector>

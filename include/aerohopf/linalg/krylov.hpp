@@ -120,6 +120,11 @@ struct krylov_state {
     if constexpr (distributed_operator<Op, real>) a.global_sum(&v, 1);
     return v;
   }
+  /// v == 0 everywhere (on every process: the answer is the same on all)
+  bool all_zero(const vec<S>& v) const {
+    if constexpr (distributed_operator<Op, real>) return global_sum(real(v.isZero(0.0) ? 0 : 1)) == real(0);
+    else return v.isZero(0.0);
+  }
   /// ||v|| of the whole (distributed) vector: sqrt of the summed squares, bitwise v.norm() for a
   /// local operator.
   real norm(const vec<S>& v) const {
@@ -162,7 +167,7 @@ struct krylov_state {
   /// b = 0: x = 0 solves A x = b exactly for any A. Reports ||A x0|| as the initial residual.
   bool zero_rhs() const { return rep.rhs_norm == 0.0; }
   krylov_report zero_solution() {
-    if (norm(x) != real(0)) {
+    if (!all_zero(x)) {
       vec<S> ax(b.size());
       op(x, ax);
       rep.initial_residual = static_cast<double>(norm(ax));
