@@ -26,7 +26,9 @@
 #include <aerohopf/flow/jacobian.hpp>
 #include <aerohopf/linalg/block_sparse_matrix.hpp>
 
+#include <complex>
 #include <cstddef>
+#include <type_traits>
 #include <exception>
 #include <stdexcept>
 #include <string>
@@ -154,32 +156,39 @@ class distributed_euler {
   const flow::jacobian_numbering& numbering() const { return numbering_; }
 
   /// `local` followed by the values of the received cells (numbering().cols cells): sends the
-  /// cells other ranks read and receives those this rank reads (collective).
-  vec<double> with_ghosts(const vec<double>& local) {
+  /// cells other ranks read and receives those this rank reads (collective). S is double or
+  /// std::complex<double> (sent as pairs of doubles).
+  template <class S>
+  vec<S> with_ghosts(const vec<S>& local) {
+    static_assert(std::is_same_v<S, double> || std::is_same_v<S, std::complex<double>>,
+                  "with_ghosts: double or std::complex<double> values");
+    constexpr int k = static_cast<int>(sizeof(S) / sizeof(double));  // doubles per value
     internal::collective(comm_, "distributed_euler::with_ghosts", [&] {
       require_size(local.size(), local_size(), "distributed_euler::with_ghosts", "local vector");
     });
-    vec<double> ext(numbering_.cols * nv);
+    vec<S> ext(numbering_.cols * nv);
     ext.head(local.size()) = local;
     std::vector<MPI_Request> req;
     req.reserve(2 * plan_.ranks);
     constexpr int tag = 7301;
     for (int q = 0; q < plan_.ranks; ++q) {
-      const auto n = (ghost_offset_[q + 1] - ghost_offset_[q]) * nv;
+      const auto n = (ghost_offset_[q + 1] - ghost_offset_[q]) * nv * k;
       if (n == 0) continue;
       req.emplace_back();
-      internal::check_mpi(MPI_Irecv(ext.data() + ghost_offset_[q] * nv, static_cast<int>(n), MPI_DOUBLE, q, tag,
-                                    comm_, &req.back()),
+      internal::check_mpi(MPI_Irecv(reinterpret_cast<double*>(ext.data() + ghost_offset_[q] * nv), static_cast<int>(n),
+                                    MPI_DOUBLE, q, tag, comm_, &req.back()),
                           "MPI_Irecv");
     }
     for (int q = 0; q < plan_.ranks; ++q) {
       if (send_local_[q].empty()) continue;
+      auto& buf = send_[q];
+      buf.resize(send_local_[q].size() * nv * k);  // allocates once per value type
+      S* out = reinterpret_cast<S*>(buf.data());
       std::size_t i = 0;
       for (const Eigen::Index c : send_local_[q])
-        for (int v = 0; v < nv; ++v) send_[q][i++] = local[c * nv + v];
+        for (int v = 0; v < nv; ++v) out[i++] = local[c * nv + v];
       req.emplace_back();
-      internal::check_mpi(MPI_Isend(send_[q].data(), static_cast<int>(send_[q].size()), MPI_DOUBLE, q, tag, comm_,
-                                    &req.back()),
+      internal::check_mpi(MPI_Isend(buf.data(), static_cast<int>(buf.size()), MPI_DOUBLE, q, tag, comm_, &req.back()),
                           "MPI_Isend");
     }
     internal::check_mpi(MPI_Waitall(static_cast<int>(req.size()), req.data(), MPI_STATUSES_IGNORE), "MPI_Waitall");
@@ -195,16 +204,26 @@ class distributed_euler {
                          [&] { flow::assemble_jacobian<Dim>(model_, scratch_, kind, a, &numbering_); });
   }
 
-  /// y = A x for a matrix of this rank's rows in numbering() (jacobian()) and x distributed as
-  /// states are (collective: the ghost values of x are exchanged).
-  vec<double> multiply(const block_sparse_matrix<double, nv>& a, const vec<double>& x) {
-    const vec<double> ext = with_ghosts(x);
-    vec<double> y(local_size());
+  /// y = A x for a real matrix of this rank's rows in numbering() (jacobian()) and x distributed
+  /// as states are, real or complex (collective: the ghost values of x are exchanged).
+  template <class S>
+  vec<S> multiply(const block_sparse_matrix<double, nv>& a, const vec<S>& x) {
+    const vec<S> ext = with_ghosts(x);
+    vec<S> y(local_size());
     internal::collective(comm_, "distributed_euler::multiply", [&] {
       require(a.block_rows() == numbering_.rows && a.block_cols() == numbering_.cols,
               "distributed_euler::multiply: the matrix has ", a.block_rows(), " x ", a.block_cols(),
               " blocks, this rank's numbering ", numbering_.rows, " x ", numbering_.cols);
-      a.multiply(ext, y);
+      if constexpr (std::is_same_v<S, double>) {
+        a.multiply(ext, y);
+      } else {  // a real rectangular matrix: real and imaginary parts by two real products
+        const vec<double> re = ext.real(), im = ext.imag();
+        vec<double> yr(y.size()), yi(y.size());
+        a.multiply(re, yr);
+        a.multiply(im, yi);
+        y.real() = yr;
+        y.imag() = yi;
+      }
     });
     return y;
   }
@@ -245,26 +264,35 @@ class distributed_euler {
   vec<double> scratch_, residual_;  // full length (see the memory note above)
 };
 
-/// A matrix of one rank's rows in distributed_euler's numbering (distributed_euler::jacobian, or
-/// any matrix of that pattern) as a distributed linear operator (linalg/operator.hpp): y = A x
-/// with the ghost values of x exchanged, inner products summed over the ranks, so that gmres
-/// runs the same iteration on every rank. `d` and `a` must outlive it.
-template <int Dim>
+/// A - sigma I for a matrix A of one rank's rows in distributed_euler's numbering
+/// (distributed_euler::jacobian, or any matrix of that pattern) as a distributed linear operator
+/// (linalg/operator.hpp) on real (S = double, sigma = 0) or complex vectors: the ghost values of
+/// x are exchanged for the product, inner products are summed over the ranks, so that gmres runs
+/// the same iteration on every rank. `d` and `a` must outlive it.
+template <int Dim, class S = double>
 class distributed_matrix_operator {
  public:
-  distributed_matrix_operator(distributed_euler<Dim>& d, const block_sparse_matrix<double, Dim + 2>& a, MPI_Comm comm)
-      : d_(&d), a_(&a), comm_(comm) {}
+  distributed_matrix_operator(distributed_euler<Dim>& d, const block_sparse_matrix<double, Dim + 2>& a, MPI_Comm comm,
+                              S sigma = S(0))
+      : d_(&d), a_(&a), comm_(comm), sigma_(sigma) {}
   Eigen::Index rows() const { return d_->local_size(); }
   Eigen::Index cols() const { return d_->local_size(); }
-  void apply(const vec<double>& x, vec<double>& y) const { y = d_->multiply(*a_, x); }
+  void apply(const vec<S>& x, vec<S>& y) const {
+    y = d_->multiply(*a_, x);
+    if (sigma_ != S(0)) y -= sigma_ * x;
+  }
   void global_sum(double* p, int n) const {
     internal::check_mpi(MPI_Allreduce(MPI_IN_PLACE, p, n, MPI_DOUBLE, MPI_SUM, comm_), "MPI_Allreduce");
+  }
+  void global_sum(std::complex<double>* p, int n) const {
+    internal::check_mpi(MPI_Allreduce(MPI_IN_PLACE, p, n, MPI_C_DOUBLE_COMPLEX, MPI_SUM, comm_), "MPI_Allreduce");
   }
 
  private:
   distributed_euler<Dim>* d_;
   const block_sparse_matrix<double, Dim + 2>* a_;
   MPI_Comm comm_;
+  S sigma_;
 };
 
 /// The part of a rank's rows in its own cells (columns 0 .. block_rows - 1 of the local
