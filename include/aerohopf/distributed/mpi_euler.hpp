@@ -26,6 +26,7 @@
 #include <aerohopf/flow/jacobian.hpp>
 #include <aerohopf/linalg/block_sparse_matrix.hpp>
 
+#include <array>
 #include <complex>
 #include <cstddef>
 #include <type_traits>
@@ -240,7 +241,75 @@ class distributed_euler {
     return r;
   }
 
+  /// The local time-step denominators (euler_model::spectral_radius) of this rank's cells, one
+  /// per cell (collective).
+  vec<double> spectral_radius(const vec<double>& local) {
+    load_state(local);
+    vec<double> rad(static_cast<Eigen::Index>(plan_.owned_cells()));
+    internal::collective(comm_, "distributed_euler::spectral_radius", [&] {
+      rad = cells_of(model_.spectral_radius(scratch_, &plan_.owned_blocks));
+    });
+    return rad;
+  }
+
+  /// The force coefficients of the whole body: each rank's walls, summed (collective; the same
+  /// values on every rank).
+  flow::force_coefficients forces(const vec<double>& local) {
+    load_state(local);
+    std::array<double, 6> fm{};
+    internal::collective(comm_, "distributed_euler::forces", [&] {
+      const auto c = model_.forces(scratch_, &plan_.owned_blocks);
+      for (int i = 0; i < 3; ++i) {
+        fm[i] = c.force[i];
+        fm[3 + i] = c.moment[i];
+      }
+    });
+    internal::check_mpi(MPI_Allreduce(MPI_IN_PLACE, fm.data(), 6, MPI_DOUBLE, MPI_SUM, comm_), "MPI_Allreduce");
+    return model_.coefficients({fm[0], fm[1], fm[2]}, {fm[3], fm[4], fm[5]});
+  }
+
+  /// Empty if every cell this rank's residual reads (its own and the received ones) has
+  /// positive, finite density and pressure, else which is not (collective: the halo exchange).
+  std::string nonphysical(const vec<double>& local) {
+    load_state(local);
+    const auto d = model_.first_nonphysical_cell(scratch_.data(), plan_.owned_blocks);
+    if (!d) return {};
+    return aerohopf::internal::concat("non-positive density or pressure in ", model_.cell_name(d->global),
+                                      " (state cell ", d->global, ")");
+  }
+
+  /// Cell volumes of this rank's cells, in its local order.
+  std::vector<double> volumes() const {
+    std::vector<double> v;
+    v.reserve(plan_.owned_cells());
+    for (std::size_t b = 0; b < plan_.owned_blocks.size(); ++b)
+      if (plan_.owned_blocks[b])
+        for (const double x : model_.metrics().blocks[b].volume) v.push_back(x);
+    return v;
+  }
+
+  /// Global cell number of this rank's local cell c.
+  std::size_t global_cell(Eigen::Index c) const {
+    for (const auto& [first, last] : plan_.owned) {
+      if (c < static_cast<Eigen::Index>(last - first)) return first + static_cast<std::size_t>(c);
+      c -= static_cast<Eigen::Index>(last - first);
+    }
+    throw input_error(aerohopf::internal::concat("distributed_euler::global_cell: local cell out of range"));
+  }
+
+  const flow::euler_model<Dim>& model() const { return model_; }
+  MPI_Comm communicator() const { return comm_; }
+
  private:
+  /// This rank's entries of a per-cell vector over all cells.
+  vec<double> cells_of(const vec<double>& all) const {
+    vec<double> v(static_cast<Eigen::Index>(plan_.owned_cells()));
+    Eigen::Index k = 0;
+    for (const auto& [first, last] : plan_.owned)
+      for (std::size_t c = first; c < last; ++c) v[k++] = all[static_cast<Eigen::Index>(c)];
+    return v;
+  }
+
   /// The full-length scratch holds `local` and the received cells (collective).
   void load_state(const vec<double>& local) {
     const vec<double> ext = with_ghosts(local);

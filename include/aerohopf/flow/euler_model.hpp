@@ -530,14 +530,18 @@ class euler_model {
     double pressure;
     double cp;
   };
-  std::vector<wall_face> wall_faces(const vec<double>& w) const {
+  /// With `blocks` (one entry per block), the faces of the selected blocks only, reading the
+  /// cells residual_of_blocks reads.
+  std::vector<wall_face> wall_faces(const vec<double>& w, const std::vector<char>* blocks = nullptr) const {
     check_state_vector(w, "euler_model::wall_faces");
+    if (blocks) require_size(blocks->size(), pdims_.size(), "euler_model::wall_faces", "block selection");
     std::vector<std::vector<state<double, Dim>>> padded;
-    fill_padded<double>(metrics_, w.data(), padded);
+    fill_padded<double>(metrics_, w.data(), padded, blocks);
     std::vector<wall_face> out;
     const double pinf = fs_.pressure();
     for (const auto& h : halos_) {
       if (h.kind != boundary_kind::wall || !tagged(h.patch)) continue;
+      if (blocks && !(*blocks)[h.block]) continue;
       if (padded_layer(h) != 0) continue;
       const int b = h.block;
       // Local line of 4 cells across the face (cm - stride .. c0 + stride) in padded indexing.
@@ -562,11 +566,14 @@ class euler_model {
     return out;
   }
 
-  force_coefficients forces(const vec<double>& w) const {
+  /// Force and moment coefficients of the tagged walls. With `blocks`, the walls of the
+  /// selected blocks only: their force and moment are the parts of a partitioned grid, summed
+  /// over the parts and turned into cl, cd, cm by coefficients().
+  force_coefficients forces(const vec<double>& w, const std::vector<char>* blocks = nullptr) const {
     check_state_vector(w, "euler_model::forces");
     force_coefficients c;
     const double pinf = fs_.pressure();
-    for (const auto& f : wall_faces(w)) {
+    for (const auto& f : wall_faces(w, blocks)) {
       std::array<double, 3> fc{}, r{};
       for (int d = 0; d < Dim; ++d) {
         fc[d] = 2.0 * (f.pressure - pinf) * f.area_out[d];
@@ -577,6 +584,14 @@ class euler_model {
       c.moment[1] += r[2] * fc[0] - r[0] * fc[2];
       c.moment[2] += r[0] * fc[1] - r[1] * fc[0];
     }
+    return coefficients(c.force, c.moment);
+  }
+
+  /// cl, cd, cm (wind axes of the free stream) from body-axis force and moment coefficients.
+  force_coefficients coefficients(const std::array<double, 3>& force, const std::array<double, 3>& moment) const {
+    force_coefficients c;
+    c.force = force;
+    c.moment = moment;
     const double ca = std::cos(fs_.alpha_rad), sa = std::sin(fs_.alpha_rad);
     if constexpr (Dim == 2) {
       c.cl = -c.force[0] * sa + c.force[1] * ca;
@@ -592,12 +607,16 @@ class euler_model {
 
   /// Sum over the faces of a cell of (|u.n - s_n| + c) |S|: the local time step is
   /// CFL * V / this (spectral radius of the flux Jacobian, first-order states).
-  vec<double> spectral_radius(const vec<double>& w) const {
+  /// With `blocks`, the selected blocks' cells only (the others stay 0), reading the cells
+  /// residual_of_blocks reads.
+  vec<double> spectral_radius(const vec<double>& w, const std::vector<char>* blocks = nullptr) const {
     check_state_vector(w, "euler_model::spectral_radius");
+    if (blocks) require_size(blocks->size(), pdims_.size(), "euler_model::spectral_radius", "block selection");
     vec<double> rad = vec<double>::Zero(static_cast<Eigen::Index>(n_cells()));
     std::vector<std::vector<state<double, Dim>>> padded;
-    fill_padded<double>(metrics_, w.data(), padded);
+    fill_padded<double>(metrics_, w.data(), padded, blocks);
     for (std::size_t b = 0; b < padded.size(); ++b) {
+      if (blocks && !(*blocks)[b]) continue;
       const auto& mb = metrics_.blocks[b];
       for (int d = 0; d < Dim; ++d) {
         const auto fd = mb.face_dims(d);

@@ -26,11 +26,13 @@
 // Input checks (input_error, before w or the model is touched): the options (finite, in range),
 // the state size, finite entries (the first bad one named) and positive density and pressure.
 #include <chrono>
+#include <concepts>
 #include <cmath>
 #include <cstdio>
 #include <functional>
 #include <ostream>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "../error.hpp"
@@ -124,22 +126,143 @@ inline Eigen::Index first_non_finite(const vec<double>& v) {
 }
 }  // namespace internal
 
-/// Drives w (in: initial guess, out: converged state, or the last accepted one on failure) to
-/// R(w) = 0 with R evaluated by `residual(w)` (the model's own residual in the overload below;
-/// a wrapper serves monitoring or fault injection), the Jacobians and time steps by the model.
-/// With the vortex far field the model's circulation is updated (hence the non-const model).
-/// Failures: file comment.
+/// What the steady solver needs of a discretisation: the serial Euler model
+/// (euler_discretisation below) or one rank's part of a partitioned grid
+/// (distributed/mpi_steady.hpp). Vectors are the caller's part of the state (all of it in
+/// serial); every member that decides something (`agree`, `global_sum`, `collective`) gives
+/// the same answer on every process, so that the solver takes the same branches everywhere.
+///  - block_size: values per cell; size(): values of the caller's part;
+///  - residual(w), spectral_radius(w) (one value per cell), volumes() (one per cell);
+///  - jacobian(w, kind, a): the caller's block rows of dR/dw;
+///  - preconditioning_part(a): the matrix BILU(k) factorises (a itself, or its square part of
+///    the caller's own cells: block Jacobi);
+///  - gmres(a, pc, b, x, options): GMRES on the operator of a;
+///  - global_sum(p, n): sums over the processes (no-op in serial);
+///  - agree(text): the first non-empty text of any process, on every process;
+///  - collective(what, f): runs f; if it throws anywhere, it throws everywhere;
+///  - check_initial(w, who): size, finite entries, physical state (input_error);
+///  - nonphysical(w): empty or which cell is not physical (this process's cells);
+///  - forces(w): the force coefficients of the whole body;
+///  - vortex(), circulation(), set_circulation(g): the vortex far field;
+///  - conditions_text(): "M = .., alpha = .. deg" for messages;
+///  - largest_residual(r): {norm, cell name} of the cell with the largest residual anywhere.
+template <class D>
+concept steady_discretisation =
+    requires(D& d, const vec<double>& w, jacobian_kind k, block_sparse_matrix<double, D::block_size>& a, double* p,
+             const std::string& text) {
+      { D::block_size } -> std::convertible_to<int>;
+      { d.size() } -> std::convertible_to<Eigen::Index>;
+      { d.residual(w) } -> std::convertible_to<vec<double>>;
+      { d.spectral_radius(w) } -> std::convertible_to<vec<double>>;
+      { d.volumes() } -> std::convertible_to<const std::vector<double>&>;
+      d.jacobian(w, k, a);
+      { d.preconditioning_part(a) } -> std::convertible_to<const block_sparse_matrix<double, D::block_size>&>;
+      d.global_sum(p, 1);
+      { d.agree(text) } -> std::convertible_to<std::string>;
+      d.check_initial(w, "who");
+      { d.nonphysical(w) } -> std::convertible_to<std::string>;
+      { d.forces(w) } -> std::convertible_to<force_coefficients>;
+      { d.vortex() } -> std::convertible_to<bool>;
+      { d.circulation() } -> std::convertible_to<double>;
+      d.set_circulation(1.0);
+      { d.conditions_text() } -> std::convertible_to<std::string>;
+      { d.largest_residual(w) } -> std::convertible_to<std::pair<double, std::string>>;
+    };
+
+/// The serial Euler model as a steady_discretisation, R(w) evaluated by `residual(w)` (the
+/// model's own residual, or a wrapper for monitoring or fault injection).
 template <int Dim, class Residual>
-steady_report solve_steady(euler_model<Dim>& m, vec<double>& w, const steady_options& opt, Residual&& residual) {
-  constexpr int nv = Dim + 2;
+class euler_discretisation {
+ public:
+  static constexpr int block_size = Dim + 2;
+  euler_discretisation(euler_model<Dim>& m, Residual residual) : m_(m), residual_(std::move(residual)) {
+    vol_.reserve(m.n_cells());
+    for (const auto& b : m.metrics().blocks) vol_.insert(vol_.end(), b.volume.begin(), b.volume.end());
+  }
+  Eigen::Index size() const { return m_.size(); }
+  vec<double> residual(const vec<double>& w) { return residual_(w); }
+  vec<double> spectral_radius(const vec<double>& w) const { return m_.spectral_radius(w); }
+  const std::vector<double>& volumes() const { return vol_; }
+  void jacobian(const vec<double>& w, jacobian_kind kind, block_sparse_matrix<double, block_size>& a) const {
+    assemble_jacobian<Dim>(m_, w, kind, a);
+  }
+  const block_sparse_matrix<double, block_size>& preconditioning_part(
+      const block_sparse_matrix<double, block_size>& a) const {
+    return a;
+  }
+  template <class Pc>
+  krylov_report gmres(const block_sparse_matrix<double, block_size>& a, const Pc& pc, const vec<double>& b,
+                      vec<double>& x, const krylov_options& ko) const {
+    return aerohopf::gmres<double>(a, pc, b, x, ko);
+  }
+  void global_sum(double*, int) const {}
+  std::string agree(const std::string& text) const { return text; }
+  template <class F>
+  void collective(const char*, F&& f) const {
+    f();
+  }
+  void check_initial(const vec<double>& w, const char* who) const {
+    require_size(w.size(), m_.size(), who, "state");
+    require_finite(w, who, "state");
+    m_.require_physical(w.data(), aerohopf::internal::concat(who, ": initial state"));
+  }
+  std::string nonphysical(const vec<double>& w) const {
+    const auto d = m_.first_nonphysical_cell(w.data());
+    if (!d) return {};
+    return aerohopf::internal::concat("non-positive density or pressure in block ", d->block, " (state cell ", d->global,
+                                      ")");
+  }
+  force_coefficients forces(const vec<double>& w) const { return m_.forces(w); }
+  bool vortex() const { return Dim == 2 && m_.options().vortex_far_field; }
+  double circulation() const { return m_.circulation(); }
+  void set_circulation(double g) { m_.set_circulation(g); }
+  std::string conditions_text() const {
+    return aerohopf::internal::concat("M = ", m_.conditions().mach, ", alpha = ", m_.conditions().alpha_rad * 180.0 / M_PI,
+                                      " deg");
+  }
+  std::pair<double, std::string> largest_residual(const vec<double>& r) const {
+    constexpr int nv = block_size;
+    Eigen::Index worst = 0;
+    double worst_norm = -1;
+    for (Eigen::Index c = 0; c < r.size() / nv; ++c)
+      if (const double v = r.segment(c * nv, nv).norm(); v > worst_norm) {
+        worst_norm = v;
+        worst = c;
+      }
+    return {worst_norm, m_.cell_name(static_cast<std::size_t>(worst))};
+  }
+
+ private:
+  euler_model<Dim>& m_;
+  Residual residual_;
+  std::vector<double> vol_;
+};
+
+/// Drives w (in: initial guess, out: converged state, or the last accepted one on failure;
+/// the caller's part of the state) to R(w) = 0 for any steady_discretisation. With the vortex
+/// far field the circulation is updated (hence the non-const discretisation). Failures: file
+/// comment.
+template <steady_discretisation D>
+steady_report solve_steady(D& d, vec<double>& w, const steady_options& opt) {
+  constexpr int nv = D::block_size;
   const char* who = "solve_steady";
   check_steady_options(opt, who);
-  require_size(w.size(), m.size(), who, "state");
-  require_finite(w, who, "state");
-  m.require_physical(w.data(), "solve_steady: initial state");
+  d.check_initial(w, who);
   const auto t0 = std::chrono::steady_clock::now();
-  const auto n = static_cast<Eigen::Index>(m.n_cells());
-  const double rootn = std::sqrt(static_cast<double>(w.size()));
+  const auto n = static_cast<Eigen::Index>(w.size() / nv);  // the caller's cells
+  double total = static_cast<double>(w.size());
+  d.global_sum(&total, 1);
+  const double rootn = std::sqrt(total);
+  auto norm = [&](const vec<double>& v) {
+    double s2 = v.squaredNorm();
+    d.global_sum(&s2, 1);
+    return std::sqrt(s2);
+  };
+  // "" if v is finite everywhere, else where it is not (the same text on every process)
+  auto non_finite = [&](const vec<double>& v, const char* what) {
+    const Eigen::Index i = internal::first_non_finite(v);
+    return d.agree(i < 0 ? std::string() : aerohopf::internal::concat(what, " not finite (entry ", i, " of ", v.size(), ")"));
+  };
   block_sparse_matrix<double, nv> a, ax;  // modified-order (preconditioner), exact (operator)
   block_ilu_options io;
   io.fill_level = opt.fill_level;
@@ -148,7 +271,7 @@ steady_report solve_steady(euler_model<Dim>& m, vec<double>& w, const steady_opt
   bool analysed = false;
   jacobian_kind kind = jacobian_kind::modified_order;
   steady_report rep;
-  const bool vortex = Dim == 2 && m.options().vortex_far_field;
+  const bool vortex = d.vortex();
   double res = NAN, cfl = NAN;
   int step = 0;
   int exact_from = -1;  // history index of the first step with the exact Jacobian
@@ -156,8 +279,8 @@ steady_report solve_steady(euler_model<Dim>& m, vec<double>& w, const steady_opt
   auto where = [&]() {
     std::string s = aerohopf::internal::concat("step ", step, " (||R||/sqrt(n) = ", res, " of the last accepted state");
     if (std::isfinite(cfl)) s += aerohopf::internal::concat(", CFL ", cfl);
-    s += aerohopf::internal::concat(", M = ", m.conditions().mach, ", alpha = ", m.conditions().alpha_rad * 180.0 / M_PI, " deg");
-    if (vortex) s += aerohopf::internal::concat(", circulation ", m.circulation());
+    s += ", " + d.conditions_text();
+    if (vortex) s += aerohopf::internal::concat(", circulation ", d.circulation());
     return s + ")";
   };
   auto finish = [&]() {
@@ -173,8 +296,8 @@ steady_report solve_steady(euler_model<Dim>& m, vec<double>& w, const steady_opt
   };
   vec<double> r;
   try {
-    if (vortex) m.set_circulation(0.5 * m.forces(w).cl);
-    r = residual(static_cast<const vec<double>&>(w));
+    if (vortex) d.set_circulation(0.5 * d.forces(w).cl);
+    r = d.residual(static_cast<const vec<double>&>(w));
   } catch (...) {
     const std::string ctx = aerohopf::internal::concat(who, ": residual of the initial state failed: ");
     rep.reason = ctx + aerohopf::internal::current_exception_text();
@@ -183,16 +306,12 @@ steady_report solve_steady(euler_model<Dim>& m, vec<double>& w, const steady_opt
     return rep;
   }
   require_size(r.size(), w.size(), who, "residual");
-  {
-    const Eigen::Index i = internal::first_non_finite(r);
-    require(i < 0, who, ": residual of the initial state is not finite (entry ", i, ")");
-  }
-  res = r.norm() / rootn;
+  if (const std::string bad = non_finite(r, "residual of the initial state"); !bad.empty())
+    throw input_error(aerohopf::internal::concat(who, ": ", bad));
+  res = norm(r) / rootn;
   rep.initial_residual = res;
   double cfl0 = opt.cfl_initial;
-  std::vector<double> vol(static_cast<std::size_t>(n));
-  for (std::size_t b = 0, c = 0; b < m.metrics().blocks.size(); ++b)
-    for (double v : m.metrics().blocks[b].volume) vol[c++] = v;
+  const std::vector<double>& vol = d.volumes();
   auto done = [&] { return res <= opt.residual_drop * rep.initial_residual || res <= opt.absolute_tolerance; };
 
   for (step = 1; step <= opt.max_steps; ++step) {
@@ -206,39 +325,37 @@ steady_report solve_steady(euler_model<Dim>& m, vec<double>& w, const steady_opt
     vec<double> wn, rn;
     krylov_report lin;
     try {
-      const vec<double> rad = m.spectral_radius(w);
+      const vec<double> rad = d.spectral_radius(w);
       auto pseudo_time_matrix = [&](jacobian_kind k, block_sparse_matrix<double, nv>& mat) {
-        assemble_jacobian<Dim>(m, w, k, mat);
+        d.jacobian(w, k, mat);
         for (auto& x : mat.values()) x = -x;
         for (Eigen::Index c = 0; c < n; ++c)
           mat.block(c, c).diagonal().array() += rad[c] / (cfl * vol[static_cast<std::size_t>(c)]);
       };
       pseudo_time_matrix(jacobian_kind::modified_order, a);
       if (kind == jacobian_kind::exact) pseudo_time_matrix(jacobian_kind::exact, ax);
-      if (!analysed) {
-        ilu.analyze(a);
-        analysed = true;
-      }
-      ilu.factorize(a);
+      const block_sparse_matrix<double, nv>& pa = d.preconditioning_part(a);
+      d.collective("solve_steady: BILU", [&] {
+        if (!analysed) ilu.analyze(pa);
+        ilu.factorize(pa);
+      });
+      analysed = true;
       krylov_options ko;
       ko.relative_tolerance = opt.linear_tolerance;
       ko.max_iterations = opt.linear_max_iterations;
       ko.restart = opt.restart;
       ko.record_history = false;
       vec<double> dw = vec<double>::Zero(w.size());
-      lin = kind == jacobian_kind::exact ? gmres<double>(ax, ilu, r, dw, ko) : gmres<double>(a, ilu, r, dw, ko);
+      lin = d.gmres(kind == jacobian_kind::exact ? ax : a, ilu, r, dw, ko);
       rep.linear_iterations += lin.iterations;
       wn = w + dw;
-      if (const Eigen::Index i = internal::first_non_finite(dw); i >= 0) {
-        rejected = aerohopf::internal::concat("update not finite (entry ", i, "; GMRES: ", lin.reason, ")");
-      } else if (const auto d = m.first_nonphysical_cell(wn.data())) {
-        rejected = aerohopf::internal::concat("non-positive density or pressure in block ", d->block, " (state cell ",
-                                              d->global, ")");
-      } else {
-        rn = residual(static_cast<const vec<double>&>(wn));
+      rejected = non_finite(dw, "update");
+      if (!rejected.empty()) {
+        rejected += aerohopf::internal::concat(" (GMRES: ", lin.reason, ")");
+      } else if (rejected = d.agree(d.nonphysical(wn)); rejected.empty()) {
+        rn = d.residual(static_cast<const vec<double>&>(wn));
         require_size(rn.size(), w.size(), who, "residual");
-        if (const Eigen::Index i = internal::first_non_finite(rn); i >= 0)
-          rejected = aerohopf::internal::concat("residual of the trial state not finite (entry ", i, " of ", rn.size(), ")");
+        rejected = non_finite(rn, "residual of the trial state");
       }
     } catch (...) {
       const std::string ctx = aerohopf::internal::concat(who, ": ", where(), " failed: ");
@@ -259,10 +376,10 @@ steady_report solve_steady(euler_model<Dim>& m, vec<double>& w, const steady_opt
     w = std::move(wn);
     double cl = NAN;
     try {
-      cl = m.forces(w).cl;
+      cl = d.forces(w).cl;
       if (vortex) {
-        m.set_circulation(0.5 * cl);  // lagged: consistent at convergence
-        rn = residual(static_cast<const vec<double>&>(w));
+        d.set_circulation(0.5 * cl);  // lagged: consistent at convergence
+        rn = d.residual(static_cast<const vec<double>&>(w));
       }
     } catch (...) {
       const std::string ctx = aerohopf::internal::concat(who, ": ", where(), " failed after its update was accepted: ");
@@ -271,10 +388,10 @@ steady_report solve_steady(euler_model<Dim>& m, vec<double>& w, const steady_opt
       if (opt.throw_on_failure) aerohopf::internal::rethrow_with_context(ctx);
       return rep;
     }
-    if (const Eigen::Index i = internal::first_non_finite(rn); i >= 0)
-      return fail(aerohopf::internal::concat("residual not finite (entry ", i, ") after the circulation update at ", where()));
+    if (const std::string bad = non_finite(rn, "residual"); !bad.empty())
+      return fail(aerohopf::internal::concat(bad, " after the circulation update at ", where()));
     r = std::move(rn);
-    res = r.norm() / rootn;
+    res = norm(r) / rootn;
     rep.history.push_back({step, res, cfl, lin.iterations, cl});
     rep.steps = step;
     if (opt.log) {
@@ -291,14 +408,7 @@ steady_report solve_steady(euler_model<Dim>& m, vec<double>& w, const steady_opt
         double best = INFINITY;
         for (int k = h - opt.stall_steps + 1; k <= h; ++k) best = std::min(best, rep.history[static_cast<std::size_t>(k)].residual);
         if (!(best < opt.stall_factor * before)) {
-          Eigen::Index worst = 0;
-          double worst_norm = -1;
-          for (Eigen::Index c = 0; c < n; ++c)
-            if (const double v = r.segment(c * nv, nv).norm(); v > worst_norm) {
-              worst_norm = v;
-              worst = c;
-            }
-          const std::string cell = m.cell_name(static_cast<std::size_t>(worst));
+          const auto [worst_norm, cell] = d.largest_residual(r);
           return fail(aerohopf::internal::concat(
               "Newton stalled: ", opt.stall_steps, " steps with the exact Jacobian took ||R|| only from ", before, " to ",
               best, " (GMRES at ", lin.iterations, " of at most ", opt.linear_max_iterations,
@@ -318,6 +428,18 @@ steady_report solve_steady(euler_model<Dim>& m, vec<double>& w, const steady_opt
   return fail(aerohopf::internal::concat("residual dropped only to ", res / rep.initial_residual, " of its initial value ",
                                rep.initial_residual, " after ", rep.steps, " accepted steps (", rep.rejections.size(),
                                " rejected) at ", where()));
+}
+
+/// solve_steady of the Euler model with R(w) evaluated by `residual(w)` (a wrapper of the
+/// model's residual for monitoring or fault injection); the Jacobians, time steps and forces
+/// are the model's. Input checks (input_error) come before w or the model is touched.
+template <int Dim, class Residual>
+steady_report solve_steady(euler_model<Dim>& m, vec<double>& w, const steady_options& opt, Residual&& residual) {
+  check_steady_options(opt, "solve_steady");
+  require_size(w.size(), m.size(), "solve_steady", "state");
+  auto fn = [&residual](const vec<double>& x) { return vec<double>(residual(x)); };
+  euler_discretisation<Dim, decltype(fn)> d(m, fn);
+  return solve_steady(d, w, opt);
 }
 
 /// solve_steady with the model's own residual.
