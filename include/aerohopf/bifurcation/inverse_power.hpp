@@ -75,6 +75,55 @@ inline vec<std::complex<double>> default_start(Eigen::Index n) {
   return x.normalized();
 }
 
+/// The vector operations of the iteration on vectors held whole by the caller. A distributed
+/// counterpart (distributed/mpi_eigen.hpp) sums them over the processes.
+struct local_vectors {
+  double squared_norm(const vec<std::complex<double>>& v) const { return v.squaredNorm(); }
+  std::complex<double> dot(const vec<std::complex<double>>& a, const vec<std::complex<double>>& b) const {
+    return a.dot(b);
+  }
+  /// The entry of largest magnitude (the first of equal ones).
+  std::complex<double> largest_entry(const vec<std::complex<double>>& x) const {
+    Eigen::Index imax = 0;
+    x.cwiseAbs().maxCoeff(&imax);
+    return x[imax];
+  }
+};
+
+/// The iteration itself, written once for any vector space (local_vectors or a distributed
+/// one): apply(v) = A v, solve(v, its) = (A - shift I)^{-1} v (its += Krylov iterations), x the
+/// unit start vector, a_norm = ||A||_inf. Convergence test and errors: file comment.
+template <class Space, class Apply, class Solve>
+eigen_pair inverse_power_iteration(const Space& space, Apply&& apply, Solve&& solve, std::complex<double> shift,
+                                   double a_norm, vec<std::complex<double>> x, const inverse_power_options& opt,
+                                   const char* who) {
+  using C = std::complex<double>;
+  eigen_pair r;
+  for (int t = 1; t <= opt.max_iterations; ++t) {
+    const vec<C> y = solve(x, r.linear_iterations);
+    const double ny2 = space.squared_norm(y);
+    if (!(ny2 > 0) || !std::isfinite(ny2))
+      throw convergence_error(internal::concat(who, ": iterate ", t, " is zero or not finite"));
+    r.lambda = shift + space.dot(y, x) / ny2;
+    x = y / std::sqrt(ny2);
+    r.residual = std::sqrt(space.squared_norm(vec<C>(apply(x) - r.lambda * x)));
+    r.iterations = t;
+    if (opt.verbose && opt.log)
+      *opt.log << who << " it " << t << "  lambda " << r.lambda << "  residual " << r.residual << "\n";
+    const double floor = 100 * std::numeric_limits<double>::epsilon() * a_norm;
+    if (r.residual <= std::max(opt.tolerance * std::max(1.0, std::abs(r.lambda)), floor)) {
+      // the free phase: largest-magnitude component real and positive, unit norm
+      const C big = space.largest_entry(x);
+      x *= std::abs(big) / big;
+      if (const double z = space.squared_norm(x); z > 0) x /= std::sqrt(z);
+      r.vector = std::move(x);
+      return r;
+    }
+  }
+  throw convergence_error(internal::concat(who, ": no convergence in ", opt.max_iterations, " iterations (shift ", shift,
+                                           ", last lambda ", r.lambda, ", residual ", r.residual, ")"));
+}
+
 template <class Matrix, class Solver>
 eigen_pair inverse_power_impl(const Matrix& a, std::complex<double> shift, const inverse_power_options& opt,
                               const vec<std::complex<double>>* start, const char* who, Solver& solver) {
@@ -123,31 +172,14 @@ eigen_pair inverse_power_impl(const Matrix& a, std::complex<double> shift, const
     }
   }
   const auto ac = a.template cast<C>();
-
-  vec<C> x = start ? start->normalized() : default_start(a.rows());
-  eigen_pair r;
-  for (int t = 1; t <= opt.max_iterations; ++t) {
-    const vec<C> y = solver.solve(x);
-    if constexpr (requires { solver.last_report().iterations; }) r.linear_iterations += solver.last_report().iterations;
-    const double ny2 = y.squaredNorm();
-    if (!(ny2 > 0) || !std::isfinite(ny2))
-      throw convergence_error(internal::concat(who, ": iterate ", t, " is zero or not finite"));
-    r.lambda = shift + y.dot(x) / ny2;
-    x = y / std::sqrt(ny2);
-    r.residual = (ac * x - r.lambda * x).norm();
-    r.iterations = t;
-    if (opt.verbose && opt.log)
-      *opt.log << who << " it " << t << "  lambda " << r.lambda << "  residual " << r.residual << "\n";
-    const double floor = 100 * std::numeric_limits<double>::epsilon() * a_norm;
-    if (r.residual <= std::max(opt.tolerance * std::max(1.0, std::abs(r.lambda)), floor)) {
-      normalise_phase(x);
-      r.vector = x;
-      return r;
-    }
-  }
-  throw convergence_error(internal::concat(who, ": no convergence in ", opt.max_iterations,
-                                           " iterations (shift ", shift, ", last lambda ", r.lambda,
-                                           ", residual ", r.residual, ")"));
+  return inverse_power_iteration(
+      local_vectors{}, [&ac](const vec<C>& v) -> vec<C> { return ac * v; },
+      [&solver](const vec<C>& v, long& linear_iterations) -> vec<C> {
+        vec<C> y = solver.solve(v);
+        if constexpr (requires { solver.last_report().iterations; }) linear_iterations += solver.last_report().iterations;
+        return y;
+      },
+      shift, a_norm, start ? vec<C>(start->normalized()) : default_start(a.rows()), opt, who);
 }
 
 }  // namespace internal

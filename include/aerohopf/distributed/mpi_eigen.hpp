@@ -1,0 +1,150 @@
+#pragma once
+// Shift-invert inverse power on MPI ranks: the eigenpair of a partitioned flow Jacobian A
+// nearest a complex shift sigma (the root locus' and the Hopf start's eigen-solve), by the one
+// iteration of bifurcation/inverse_power.hpp with its norms and inner products summed over the
+// ranks. Each solve (A - sigma I) y = x is complex GMRES on the ranks (A real, vectors
+// complex), preconditioned by block-Jacobi complex BILU(k) of each rank's square part of
+// P - sigma I, P the preconditioning matrix (the modified-order Jacobian for an exact A, or A).
+// The solves are inexact: the GMRES tolerance must lie below the eigen-tolerance (inverse
+// power's file comment). Its default, 1e-10, sits above the attainable floor near a shift
+// close to an eigenvalue (eps ||A|| / |lambda - sigma| relative: GMRES stalled at 1e-11 on the
+// test's coarse aerofoil). A shift AT an eigenvalue makes A - sigma I singular: GMRES then
+// fails (convergence_error on every rank); the root locus' shifts are the previous point's.
+
+#include <mpi.h>
+
+#include <aerohopf/bifurcation/inverse_power.hpp>
+#include <aerohopf/distributed/mpi_euler.hpp>
+#include <aerohopf/linalg/block_ilu.hpp>
+#include <aerohopf/linalg/krylov.hpp>
+
+#include <cmath>
+#include <complex>
+#include <string>
+
+namespace aerohopf::distributed {
+
+/// inverse power's vector operations on vectors distributed over `comm` (each process its
+/// part): sums of the local squared norms and inner products; the largest entry of the
+/// process holding it, broadcast.
+struct distributed_vectors {
+  MPI_Comm comm;
+
+  double squared_norm(const vec<std::complex<double>>& v) const {
+    double s = v.squaredNorm();
+    internal::check_mpi(MPI_Allreduce(MPI_IN_PLACE, &s, 1, MPI_DOUBLE, MPI_SUM, comm), "MPI_Allreduce");
+    return s;
+  }
+  std::complex<double> dot(const vec<std::complex<double>>& a, const vec<std::complex<double>>& b) const {
+    std::complex<double> s = a.dot(b);
+    internal::check_mpi(MPI_Allreduce(MPI_IN_PLACE, &s, 1, MPI_C_DOUBLE_COMPLEX, MPI_SUM, comm), "MPI_Allreduce");
+    return s;
+  }
+  std::complex<double> largest_entry(const vec<std::complex<double>>& x) const {
+    int rank = 0;
+    internal::check_mpi(MPI_Comm_rank(comm, &rank), "MPI_Comm_rank");
+    struct {
+      double value;
+      int rank;
+    } best{-1.0, rank};
+    std::complex<double> mine = 0.0;
+    if (x.size() > 0) {
+      Eigen::Index i = 0;
+      best.value = x.cwiseAbs().maxCoeff(&i);
+      mine = x[i];
+    }
+    internal::check_mpi(MPI_Allreduce(MPI_IN_PLACE, &best, 1, MPI_DOUBLE_INT, MPI_MAXLOC, comm), "MPI_Allreduce");
+    internal::check_mpi(MPI_Bcast(&mine, 1, MPI_C_DOUBLE_COMPLEX, best.rank, comm), "MPI_Bcast");
+    return mine;
+  }
+};
+
+struct distributed_inverse_power_options {
+  inverse_power_options power;  ///< tolerance on ||A x - lambda x|| / max(1, |lambda|), iterations
+  krylov_options linear;        ///< each shifted solve (relative tolerance 1e-12 by default)
+  int fill_level = 0;           ///< k of the block-Jacobi BILU(k)
+  distributed_inverse_power_options() {
+    linear.relative_tolerance = 1e-10;
+    linear.max_iterations = 500;
+    linear.restart = 100;
+    linear.record_history = false;
+  }
+};
+
+/// The eigenpair of A nearest `shift`: A a matrix of this rank's rows in d's numbering
+/// (distributed_euler::jacobian), `pre` the matrix whose block-Jacobi BILU(k) preconditions the
+/// shifted solves (nullptr: A itself), `start` this rank's part of the start vector (nullptr:
+/// the part of the serial default start, so that 1 and N ranks start alike). The vector of the
+/// result is this rank's part. Collective; input_error (on every rank) for a non-finite shift,
+/// bad options, a start of the wrong size, zero or not finite, or a non-finite matrix entry;
+/// convergence_error (every rank) if a GMRES solve or the iteration does not converge.
+template <int Dim>
+eigen_pair inverse_power(distributed_euler<Dim>& d, const block_sparse_matrix<double, Dim + 2>& a,
+                         const block_sparse_matrix<double, Dim + 2>* pre, std::complex<double> shift,
+                         const distributed_inverse_power_options& opt = {},
+                         const vec<std::complex<double>>* start = nullptr) {
+  using C = std::complex<double>;
+  constexpr int nv = Dim + 2;
+  const char* who = "distributed inverse power";
+  const MPI_Comm comm = d.communicator();
+  const distributed_vectors space{comm};
+  double a_norm = 0;
+  internal::collective(comm, who, [&] {
+    require(std::isfinite(shift.real()) && std::isfinite(shift.imag()), who, ": shift ", shift, " is not finite");
+    require(opt.power.max_iterations >= 1, who, ": max_iterations must be >= 1 (got ", opt.power.max_iterations, ")");
+    require(std::isfinite(opt.power.tolerance) && opt.power.tolerance > 0, who,
+            ": tolerance must be finite and > 0 (got ", opt.power.tolerance, ")");
+    require(opt.fill_level >= 0 && opt.fill_level <= 8, who, ": fill_level must lie in [0, 8] (got ", opt.fill_level,
+            ")");
+    for (const auto* m : {&a, pre}) {
+      if (!m) continue;
+      require(m->block_rows() == d.numbering().rows && m->block_cols() == d.numbering().cols, who, ": a matrix has ",
+              m->block_rows(), " x ", m->block_cols(), " blocks, this rank's numbering ", d.numbering().rows, " x ",
+              d.numbering().cols);
+    }
+    if (start) {
+      require_size(start->size(), d.local_size(), who, "start vector (this rank's part)");
+      require_finite(*start, who, "start vector");
+    }
+    vec<double> row_sums = vec<double>::Zero(d.local_size());
+    for (Eigen::Index i = 0; i < a.block_rows(); ++i)
+      for (auto p = a.row_ptr()[i]; p < a.row_ptr()[i + 1]; ++p) {
+        const auto& blk = a.block_at(p);
+        require(blk.allFinite(), who, ": a matrix entry in block row ", i, " (this rank's numbering) is not finite");
+        row_sums.segment(i * nv, nv) += blk.cwiseAbs().rowwise().sum();
+      }
+    a_norm = row_sums.size() ? row_sums.maxCoeff() : 0.0;
+  });
+  internal::check_mpi(MPI_Allreduce(MPI_IN_PLACE, &a_norm, 1, MPI_DOUBLE, MPI_MAX, comm), "MPI_Allreduce");
+  vec<C> x;
+  if (start) {
+    x = *start;
+  } else {  // this rank's part of the serial default start
+    const vec<C> g = aerohopf::internal::default_start(d.model().size());
+    x.resize(d.local_size());
+    x.real() = d.local_part(vec<double>(g.real()));
+    x.imag() = d.local_part(vec<double>(g.imag()));
+  }
+  const double nx2 = space.squared_norm(x);
+  internal::collective(comm, who, [&] { require(nx2 > 0, who, ": start vector is zero"); });
+  x /= std::sqrt(nx2);
+
+  block_ilu_options io;
+  io.fill_level = opt.fill_level;
+  io.context = "distributed inverse power: block-Jacobi BILU of P - sigma I";
+  block_ilu<C, nv> ilu(io);
+  internal::collective(comm, who, [&] { ilu.compute(shifted(owned_part(pre ? *pre : a), shift)); });
+  const distributed_matrix_operator<Dim, C> op(d, a, comm, shift);
+  krylov_options ko = opt.linear;
+  ko.throw_on_failure = true;
+  return aerohopf::internal::inverse_power_iteration(
+      space, [&](const vec<C>& v) { return d.multiply(a, v); },
+      [&](const vec<C>& v, long& linear_iterations) {
+        vec<C> y = vec<C>::Zero(v.size());
+        linear_iterations += gmres(op, ilu, v, y, ko).iterations;
+        return y;
+      },
+      shift, a_norm, std::move(x), opt.power, who);
+}
+
+}  // namespace aerohopf::distributed
