@@ -5,8 +5,9 @@
 // values as a local vector. The cells other ranks' halos read are sent by nonblocking
 // point-to-point messages, one per neighbouring rank (halo_plan); then the rank evaluates its
 // blocks (euler_model::residual_of_blocks, flow::assemble_jacobian with a numbering): its rows,
-// bitwise the serial ones (the same operations in the same order per cell). Jacobian rows are numbered locally: the owned cells,
-// then the received ones by source rank, so a product A x needs x's received values only.
+// bitwise the serial ones (the same operations in the same order per cell). Jacobian rows are
+// numbered locally: the owned cells, then the received ones by source rank, so a product A x
+// needs x's received values only.
 //
 // Memory: the grid and its metrics are replicated on every rank, and each rank keeps two
 // full-length scratch vectors (the state: owned and received cells current, the rest the free
@@ -101,10 +102,8 @@ class distributed_euler {
     numbering_.cols = k;
     send_local_.resize(plan_.ranks);
     send_.resize(plan_.ranks);
-    for (int q = 0; q < plan_.ranks; ++q) {
+    for (int q = 0; q < plan_.ranks; ++q)
       for (const std::size_t c : plan_.send[q]) send_local_[q].push_back(numbering_.local[c]);
-      send_[q].resize(plan_.send[q].size() * nv);
-    }
     scratch_ = model_.template free_stream_vector<double>();
     residual_.setZero(model_.size());
   }
@@ -230,16 +229,29 @@ class distributed_euler {
   }
 
   /// R in this rank's cells at the distributed state whose local part is `local` (collective).
-  vec<double> residual(const vec<double>& local) {
+  vec<double> residual(const vec<double>& local) { return residual(local, model_.metrics()); }
+
+  /// The same on other metrics of the model's grid (a moved grid: an aeroelastic system's).
+  vec<double> residual(const vec<double>& local, const flow::grid_metrics<double, Dim>& metrics) {
     load_state(local);
     vec<double> r(local_size());
     internal::collective(comm_, "distributed_euler::residual", [&] {
-      model_.template residual_of_blocks<double>(model_.metrics(), scratch_.data(), residual_.data(),
-                                                 plan_.owned_blocks);
+      model_.template residual_of_blocks<double>(metrics, scratch_.data(), residual_.data(), plan_.owned_blocks);
       r = local_part(residual_);
     });
     return r;
   }
+
+  /// The whole-grid state as this rank sees it after the halo exchange of `local` (collective):
+  /// its own and its received cells current, every other cell the free stream (physical, never
+  /// read by this rank's evaluations). Valid until the next evaluation.
+  const vec<double>& state_with_halo(const vec<double>& local) {
+    load_state(local);
+    return scratch_;
+  }
+
+  /// The blocks this rank owns (one entry per block of the grid).
+  const std::vector<char>& owned_blocks() const { return plan_.owned_blocks; }
 
   /// The local time-step denominators (euler_model::spectral_radius) of this rank's cells, one
   /// per cell (collective).

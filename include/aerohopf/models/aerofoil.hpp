@@ -184,7 +184,12 @@ class aerofoil_system {
   /// a residual on the medium grid, measured).
   template <class T>
   flow::grid_metrics<T, 2> moved_metrics(const vec<T>& w) const {
-    const coupling::rigid_pose<T> q = pose<T>(w);
+    return moved_metrics<T>(pose<T>(w));
+  }
+
+  /// The same for the pose q (h, h', alpha, alpha') itself.
+  template <class T>
+  flow::grid_metrics<T, 2> moved_metrics(const coupling::rigid_pose<T>& q) const {
     coupling::require_finite_pose(q, "aerofoil_system::moved_metrics");
     const coupling::rigid_rotation<T> rot(q.alpha);
     const auto& rest = flow_.metrics();
@@ -327,10 +332,22 @@ class aerofoil_system {
   template <class T>
   std::pair<T, T> loads(const flow::grid_metrics<T, 2>& m, const coupling::rigid_rotation<T>& rot,
                         const vec<T>& w) const {
+    return loads_of_blocks<T>(m, rot, w.data(), nullptr);
+  }
+
+ public:
+  /// The part of (C_l, C_m) carried by the wall faces of the selected blocks (blocks[b] != 0;
+  /// all blocks with nullptr) at the flow state wf (flow_size() values; only the selected
+  /// blocks' wall cells are read), on metrics m moved by the rotation rot: the loads of a grid
+  /// partitioned over processes are the sum of its parts (distributed/mpi_aerofoil.hpp).
+  template <class T>
+  std::pair<T, T> loads_of_blocks(const flow::grid_metrics<T, 2>& m, const coupling::rigid_rotation<T>& rot, const T* wf,
+                                  const std::vector<char>* blocks) const {
     const T pinf = T(flow_.conditions().pressure());
     T cl = T(0.0), cm = T(0.0);
     for (const auto& f : walls_) {
-      const T p0 = flow::pressure_at<T, 2>(w.data() + f.cell0 * nv), p1 = flow::pressure_at<T, 2>(w.data() + f.cell1 * nv);
+      if (blocks && !(*blocks)[static_cast<std::size_t>(f.block)]) continue;
+      const T p0 = flow::pressure_at<T, 2>(wf + f.cell0 * nv), p1 = flow::pressure_at<T, 2>(wf + f.cell1 * nv);
       const T dp = T(1.5) * p0 - T(0.5) * p1 - pinf;
       const auto [l, c] = face_load_per_pressure<T>(m, rot, f);
       cl += l * dp;
@@ -339,6 +356,36 @@ class aerofoil_system {
     return {cl, cm};
   }
 
+  /// The entries of A_sf = d(structural rates)/d(flow unknowns) from the wall faces of the
+  /// selected blocks (all with nullptr): fn(i, cell, v, value) adds `value` to row i (structural
+  /// unknown) and column cell * nv + v; w is the whole state (its flow part read only at those
+  /// blocks' wall cells, its structural part for the pose). The loads are linear in the wall
+  /// pressures, p_w = 1.5 p_0 - 0.5 p_1, so these are all of A_sf; dp/dw by a local jet per cell.
+  template <class Fn>
+  void structure_flow_entries(const flow::grid_metrics<double, 2>& m, const coupling::rigid_rotation<double>& rot,
+                              const double* wf, const std::vector<char>* blocks, Fn&& fn) const {
+    using cjet = jet<double, nv>;
+    const auto& minv = structure_.mass_inverse();
+    const double pi = std::numbers::pi, mus = structure_.parameters().mu_s;
+    const double kl = 2.0 / (pi * mus), km = 4.0 / (pi * mus);
+    for (const auto& f : walls_) {
+      if (blocks && !(*blocks)[static_cast<std::size_t>(f.block)]) continue;
+      const auto [l, c] = face_load_per_pressure<double>(m, rot, f);
+      for (int which = 0; which < 2; ++which) {
+        const Eigen::Index cell = which == 0 ? f.cell0 : f.cell1;
+        const double weight = which == 0 ? 1.5 : -0.5;
+        std::array<cjet, nv> wc;
+        for (int u = 0; u < nv; ++u) wc[u] = cjet::variable(wf[cell * nv + u], u);
+        const cjet p = flow::pressure_at<cjet, 2>(wc.data());
+        for (int v = 0; v < nv; ++v) {
+          const double dp = weight * p.derivative(v);
+          for (int i = 0; i < 4; ++i) fn(i, cell, v, (minv(i, 1) * kl * l + minv(i, 3) * km * c) * dp);
+        }
+      }
+    }
+  }
+
+ private:
   jacobian_type assemble(const vec<double>& w, double mu, flow::jacobian_kind kind) const {
     return assemble_blocks(w, mu, kind).to_sparse();
   }
@@ -386,28 +433,11 @@ class aerofoil_system {
         if (i < nf_) fs(i, j) = rj[i].derivative(j);
         else ss(i - nf_, j) = rj[i].derivative(j);
       }
-    // A_sf: loads are linear in the wall pressures; dp/dw of the wall cells by a local jet
-    // in the cell's nv unknowns.
-    using cjet = jet<double, nv>;
+    // A_sf: loads are linear in the wall pressures (structure_flow_entries)
     const auto m = moved_metrics<double>(w);
     const coupling::rigid_rotation<double> rot(w[nf_ + 2]);
-    const auto& minv = structure_.mass_inverse();
-    const double pi = std::numbers::pi, mus = structure_.parameters().mu_s;
-    const double kl = 2.0 / (pi * mus), km = 4.0 / (pi * mus);
-    for (const auto& f : walls_) {
-      const auto [l, c] = face_load_per_pressure<double>(m, rot, f);
-      for (int which = 0; which < 2; ++which) {
-        const Eigen::Index cell = which == 0 ? f.cell0 : f.cell1;
-        const double weight = which == 0 ? 1.5 : -0.5;
-        std::array<cjet, nv> wc;
-        for (int u = 0; u < nv; ++u) wc[u] = cjet::variable(w[cell * nv + u], u);
-        const cjet p = flow::pressure_at<cjet, 2>(wc.data());
-        for (int v = 0; v < nv; ++v) {
-          const double dp = weight * p.derivative(v);
-          for (int i = 0; i < 4; ++i) sf(i, cell * nv + v) += (minv(i, 1) * kl * l + minv(i, 3) * km * c) * dp;
-        }
-      }
-    }
+    structure_flow_entries(m, rot, w.data(), nullptr,
+                           [&sf](int i, Eigen::Index cell, int v, double x) { sf(i, cell * nv + v) += x; });
     return {std::move(aff), std::move(fs), std::move(sf), std::move(ss), name};
   }
 

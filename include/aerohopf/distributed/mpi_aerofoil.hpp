@@ -1,0 +1,402 @@
+#pragma once
+// The pitch-plunge aerofoil (models/aerofoil.hpp) on MPI ranks: the flow grid partitioned as in
+// mpi_euler.hpp, the four structural unknowns (h, h', alpha, alpha') on one rank, the root.
+//
+// Local vectors: this rank's flow values (distributed_euler's order), then 4 structural values,
+// which are significant on the root only: on input the root's are broadcast (the others' are
+// not read), on output the other ranks hold zeros there. A sum over the ranks of local inner
+// products therefore counts the structure once, so these vectors serve the distributed Krylov
+// methods as they are.
+//
+// Evaluations, each collective and each equal to the serial system's (tests on 2 and 3 ranks):
+//  - residual: the flow rows of the rank's cells on the grid moved to the structural state
+//    (aerofoil_system::moved_metrics and the rest model's residual_of_blocks, bitwise the serial
+//    rows) and the structural rates from the
+//    loads, whose parts (the wall faces of each rank's blocks) are summed over the ranks;
+//  - jacobian: the bordered form in the rank's rows: A_ff (distributed_euler's numbering, on the
+//    moved grid as the serial assembly), A_fs (its rows) and A_ss from one jet<double, 4> pass of
+//    the rank's residual and loads (the loads' derivatives summed over the ranks), A_sf (its
+//    wall cells' columns); multiply() applies it with the structural part broadcast from the root
+//    and the structural rows summed onto it.
+// Eigenpairs: inverse_power(d, J rows, P rows, shift) below, GMRES on J - sigma I with
+// distributed_aerofoil_preconditioner (block-Jacobi BILU of the flow, the border eliminated
+// exactly): the root locus' and the Hopf start's eigen-solve on the ranks.
+// Memory: as distributed_euler (the grid replicated), plus a moved copy of the flow model and,
+// during the jet pass, a whole-grid jet state (five doubles per value).
+
+#include <mpi.h>
+
+#include <aerohopf/distributed/mpi_eigen.hpp>
+#include <aerohopf/distributed/mpi_euler.hpp>
+#include <aerohopf/linalg/block_ilu.hpp>
+#include <aerohopf/linalg/krylov.hpp>
+#include <aerohopf/models/aerofoil.hpp>
+#include <aerohopf/scalar/jet.hpp>
+
+#include <Eigen/LU>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <complex>
+#include <type_traits>
+#include <string>
+#include <vector>
+
+namespace aerohopf::distributed {
+
+class distributed_aerofoil {
+ public:
+  static constexpr int nv = 4;
+  static constexpr int ns = models::aerofoil_system::n_structure;
+  static constexpr int root = 0;
+
+  /// The Jacobian in this rank's rows, bordered (file comment).
+  struct jacobian_rows {
+    block_sparse_matrix<double, nv> flow;  ///< A_ff: this rank's cells' rows, distributed_euler's numbering
+    Eigen::MatrixXd flow_structure;        ///< A_fs: this rank's flow rows x 4
+    Eigen::MatrixXd structure_flow;        ///< A_sf: 4 x this rank's flow values (its wall cells' columns)
+    Eigen::Matrix4d structure;             ///< A_ss (the same on every rank)
+  };
+
+  /// `sys` (the same on every rank) must outlive this object; `part` assigns its flow grid's
+  /// blocks to the ranks of `comm`. Collective.
+  distributed_aerofoil(const models::aerofoil_system& sys, const block_partition& part, MPI_Comm comm)
+      : sys_(sys), moved_(sys.flow()), d_(moved_, part, comm), comm_(comm) {}
+
+  int rank() const { return d_.rank(); }
+  distributed_euler<2>& flow() { return d_; }
+  Eigen::Index flow_size() const { return d_.local_size(); }
+  Eigen::Index local_size() const { return d_.local_size() + ns; }
+
+  /// This rank's part of a whole state or vector (sys.size() values): its flow values, then the
+  /// structure on the root and zeros elsewhere.
+  vec<double> local_part(const vec<double>& global) const {
+    require_size(global.size(), sys_.size(), "distributed_aerofoil::local_part", "global vector");
+    vec<double> local(local_size());
+    local.head(flow_size()) = d_.local_part(global.head(sys_.flow_size()));
+    local.tail(ns) = d_.rank() == root ? vec<double>(global.tail(ns)) : vec<double>::Zero(ns);
+    return local;
+  }
+
+  /// The whole vector from every rank's part, on every rank (collective; output and tests).
+  vec<double> all_gather(const vec<double>& local) {
+    check_local(local, "distributed_aerofoil::all_gather");
+    vec<double> global(sys_.size());
+    global.head(sys_.flow_size()) = d_.all_gather(local.head(flow_size()));
+    global.tail(ns) = structure_of(local);
+    return global;
+  }
+
+  /// f(w, Ubar) in this rank's part (collective).
+  vec<double> residual(const vec<double>& local, double ubar) {
+    check_local(local, "distributed_aerofoil::residual");
+    const Eigen::Vector4d ws = structure_of(local);
+    const coupling::rigid_pose<double> q{ws[0], ws[1], ws[2], ws[3]};
+    const auto m = sys_.moved_metrics<double>(q);
+    vec<double> r(local_size());
+    const vec<double>& full = d_.state_with_halo(local.head(flow_size()));
+    residual_.resize(full.size());
+    internal::collective(comm_, "distributed_aerofoil::residual", [&] {
+      sys_.flow().residual_of_blocks<double>(m, full.data(), residual_.data(), d_.owned_blocks());
+    });
+    r.head(flow_size()) = d_.local_part(residual_);
+    auto [cl, cm] = sys_.loads_of_blocks<double>(m, coupling::rigid_rotation<double>(ws[2]), full.data(),
+                                                 &d_.owned_blocks());
+    std::array<double, 2> loads{cl, cm};
+    internal::check_mpi(MPI_Allreduce(MPI_IN_PLACE, loads.data(), 2, MPI_DOUBLE, MPI_SUM, comm_), "MPI_Allreduce");
+    const auto rs = sys_.structure().rate<double>(ws, loads[0], loads[1], ubar);
+    // element by element: GCC 12 with AVX-512 warns falsely on a fixed-to-dynamic copy
+    for (int i = 0; i < ns; ++i) r[flow_size() + i] = d_.rank() == root ? rs[i] : 0.0;
+    return r;
+  }
+
+  /// The exact (kind exact) or modified-order Jacobian in this rank's rows at (w, Ubar)
+  /// (collective). The border is the same for both kinds.
+  void jacobian(const vec<double>& local, double ubar, flow::jacobian_kind kind, jacobian_rows& j) {
+    check_local(local, "distributed_aerofoil::jacobian");
+    const Eigen::Vector4d ws = structure_of(local);
+    const vec<double> wf = local.head(flow_size());
+    // A_ff on the grid moved to ws, as the serial assembly (the rest model when ws = 0)
+    if (ws.isZero(0.0)) {
+      if (moved_is_moved_) {
+        moved_ = sys_.flow();  // the rest model itself (its metrics as constructed); d_ keeps its address
+        moved_is_moved_ = false;
+      }
+    } else {
+      flow::multiblock_points<double, 2> pts, spd;
+      coupling::rigid_grid_motion<double>(sys_.flow().grid().points, coupling::rigid_pose<double>{ws[0], ws[1], ws[2], ws[3]},
+                                          {sys_.structure().parameters().x_ea, sys_.structure().parameters().y_ea}, pts,
+                                          &spd);
+      moved_.set_grid_motion(pts, &spd);
+      moved_is_moved_ = true;
+    }
+    d_.jacobian(wf, kind, j.flow);
+
+    // [A_fs; A_ss]: one jet pass (direction k = structural unknown k) of this rank's residual
+    // and of its part of the loads
+    using sjet = jet<double, ns>;
+    const vec<double>& full = d_.state_with_halo(wf);
+    vec<sjet> wj = full.cast<sjet>();
+    coupling::rigid_pose<sjet> qj{sjet::variable(ws[0], 0), sjet::variable(ws[1], 1), sjet::variable(ws[2], 2),
+                                  sjet::variable(ws[3], 3)};
+    const auto mj = sys_.moved_metrics<sjet>(qj);
+    vec<sjet> rj(full.size());
+    const auto& model = sys_.flow();
+    internal::collective(comm_, "distributed_aerofoil::jacobian", [&] {
+      model.residual_of_blocks<sjet>(mj, wj.data(), rj.data(), d_.owned_blocks());
+    });
+    const auto& num = d_.numbering();
+    j.flow_structure.resize(flow_size(), ns);
+    for (const auto& [first, last] : d_.plan().owned)
+      for (std::size_t c = first; c < last; ++c)
+        for (int v = 0; v < nv; ++v)
+          for (int k = 0; k < ns; ++k)
+            j.flow_structure(num.local[c] * nv + v, k) = rj[static_cast<Eigen::Index>(c * nv + v)].derivative(k);
+    const auto [clj, cmj] = sys_.loads_of_blocks<sjet>(mj, coupling::rigid_rotation<sjet>(qj.alpha), wj.data(),
+                                                       &d_.owned_blocks());
+    std::array<double, 2 * (ns + 1)> parts{};
+    parts[0] = clj.value();
+    parts[ns + 1] = cmj.value();
+    for (int k = 0; k < ns; ++k) {
+      parts[1 + k] = clj.derivative(k);
+      parts[ns + 2 + k] = cmj.derivative(k);
+    }
+    internal::check_mpi(MPI_Allreduce(MPI_IN_PLACE, parts.data(), static_cast<int>(parts.size()), MPI_DOUBLE, MPI_SUM, comm_),
+                        "MPI_Allreduce");
+    sjet cl(parts[0]), cm(parts[ns + 1]);
+    for (int k = 0; k < ns; ++k) {
+      cl.derivative(k) = parts[1 + k];
+      cm.derivative(k) = parts[ns + 2 + k];
+    }
+    Eigen::Matrix<sjet, 4, 1> wsj;
+    for (int k = 0; k < ns; ++k) wsj[k] = sjet::variable(ws[k], k);
+    const auto rs = sys_.structure().rate<sjet>(wsj, cl, cm, sjet(ubar));
+    for (int i = 0; i < ns; ++i)
+      for (int k = 0; k < ns; ++k) j.structure(i, k) = rs[i].derivative(k);
+
+    // A_sf: this rank's wall cells
+    j.structure_flow.setZero(ns, flow_size());
+    const auto m = sys_.moved_metrics<double>(coupling::rigid_pose<double>{ws[0], ws[1], ws[2], ws[3]});
+    sys_.structure_flow_entries(m, coupling::rigid_rotation<double>(ws[2]), full.data(), &d_.owned_blocks(),
+                                [&](int i, Eigen::Index cell, int v, double x) {
+                                  j.structure_flow(i, num.local[static_cast<std::size_t>(cell)] * nv + v) += x;
+                                });
+  }
+
+  /// y = J x in this rank's part, real or complex vectors (collective: the flow's halo, the
+  /// structure's broadcast and the structural rows' sum).
+  template <class S = double>
+  vec<S> multiply(const jacobian_rows& j, const vec<S>& x) {
+    static_assert(std::is_same_v<S, double> || std::is_same_v<S, std::complex<double>>,
+                  "distributed_aerofoil::multiply: double or std::complex<double> vectors");
+    check_local(x, "distributed_aerofoil::multiply");
+    // dynamic-size operands throughout: GCC 12 with AVX-512 warns falsely (-Warray-bounds) on
+    // products of a fixed 4-vector with dynamic matrices
+    const vec<S> xs = structure_of(x);
+    const vec<S> xf = x.head(flow_size());
+    vec<S> y(local_size());
+    y.head(flow_size()) = d_.multiply(j.flow, xf);
+    y.head(flow_size()).noalias() += j.flow_structure * xs;
+    vec<S> part = j.structure_flow * xf;
+    sum(part.data(), ns);
+    if (d_.rank() == root) {
+      const Eigen::MatrixXd ss = j.structure;
+      part.noalias() += ss * xs;
+      y.tail(ns) = part;
+    } else {
+      y.tail(ns).setZero();
+    }
+    return y;
+  }
+
+  /// The root's structural values of a local vector, on every rank (collective).
+  template <class S>
+  vec<S> structure_of(const vec<S>& local) const {
+    vec<S> s = local.tail(ns);
+    internal::check_mpi(MPI_Bcast(s.data(), ns * static_cast<int>(sizeof(S) / sizeof(double)), MPI_DOUBLE, root, comm_),
+                        "MPI_Bcast");
+    return s;
+  }
+
+  /// In-place sum over the ranks (collective).
+  void sum(double* p, int n) const {
+    internal::check_mpi(MPI_Allreduce(MPI_IN_PLACE, p, n, MPI_DOUBLE, MPI_SUM, comm_), "MPI_Allreduce");
+  }
+  void sum(std::complex<double>* p, int n) const {
+    internal::check_mpi(MPI_Allreduce(MPI_IN_PLACE, p, n, MPI_C_DOUBLE_COMPLEX, MPI_SUM, comm_), "MPI_Allreduce");
+  }
+  MPI_Comm communicator() const { return comm_; }
+
+ private:
+  template <class S>
+  void check_local(const vec<S>& local, const char* who) const {
+    internal::collective(comm_, who, [&] {
+      require_size(local.size(), local_size(), who, "local vector (this rank's flow values and 4 structural)");
+    });
+  }
+
+  const models::aerofoil_system& sys_;
+  flow::euler_model<2> moved_;  // the flow model on the grid moved to the last Jacobian's pose
+  distributed_euler<2> d_;      // evaluates on moved_ (its metrics: the rest ones or moved)
+  MPI_Comm comm_;
+  vec<double> residual_;  // whole-grid residual buffer (this rank's cells written)
+  bool moved_is_moved_ = false;
+};
+
+/// J - sigma I of a distributed_aerofoil's Jacobian rows as a distributed linear operator on
+/// complex local vectors (inner products summed over the ranks: the structure counts once).
+/// `d` and `j` must outlive it.
+class distributed_aerofoil_operator {
+ public:
+  distributed_aerofoil_operator(distributed_aerofoil& d, const distributed_aerofoil::jacobian_rows& j,
+                                std::complex<double> sigma)
+      : d_(&d), j_(&j), sigma_(sigma) {}
+  Eigen::Index rows() const { return d_->local_size(); }
+  Eigen::Index cols() const { return d_->local_size(); }
+  void apply(const vec<std::complex<double>>& x, vec<std::complex<double>>& y) const {
+    y = d_->multiply(*j_, x);
+    if (d_->rank() == distributed_aerofoil::root) y -= sigma_ * x;
+    else y.head(d_->flow_size()) -= sigma_ * x.head(d_->flow_size());
+  }
+  void global_sum(double* p, int n) const { d_->sum(p, n); }
+  void global_sum(std::complex<double>* p, int n) const { d_->sum(p, n); }
+
+ private:
+  distributed_aerofoil* d_;
+  const distributed_aerofoil::jacobian_rows* j_;
+  std::complex<double> sigma_;
+};
+
+/// Block-Jacobi preconditioner of P - sigma I for a distributed_aerofoil (P: the Jacobian rows
+/// of the preconditioning matrix, the modified-order one): complex BILU(k) M of each rank's own
+/// part of A_ff - sigma I, and the border eliminated exactly around it. With Y = M^{-1} A_fs
+/// (this rank's rows) and the Schur complement S = (A_ss - sigma I) - sum over ranks A_sf Y
+/// (4 x 4, the same LU on every rank), z = P^{-1} r is y_f = M^{-1} r_f, z_s = S^{-1} (r_s -
+/// sum A_sf y_f), z_f = y_f - Y z_s: one BILU solve and two small reductions per apply.
+class distributed_aerofoil_preconditioner {
+ public:
+  using C = std::complex<double>;
+  explicit distributed_aerofoil_preconditioner(block_ilu_options o = {}) : ilu_(std::move(o)) {}
+
+  /// Collective; singular_matrix_error (every rank) if a BILU pivot or the Schur complement is
+  /// singular.
+  void compute(distributed_aerofoil& d, const distributed_aerofoil::jacobian_rows& p, C sigma) {
+    d_ = &d;
+    internal::collective(d.communicator(), "distributed_aerofoil_preconditioner", [&] {
+      ilu_.compute(shifted(owned_part(p.flow), sigma));
+      y_.resize(d.flow_size(), distributed_aerofoil::ns);
+      vec<C> col(d.flow_size()), out(d.flow_size());
+      for (int k = 0; k < distributed_aerofoil::ns; ++k) {
+        col = p.flow_structure.col(k).cast<C>();
+        ilu_.apply(col, out);
+        y_.col(k) = out;
+      }
+      sf_ = p.structure_flow.cast<C>();
+    });
+    Eigen::MatrixXcd t = sf_ * y_;
+    d.sum(t.data(), 16);
+    Eigen::Matrix4cd schur = p.structure.cast<C>();
+    schur -= t;
+    schur.diagonal().array() -= sigma;
+    lu_.compute(schur);
+    if (!(std::abs(lu_.determinant()) > 0) || !std::isfinite(std::abs(lu_.determinant())))
+      throw singular_matrix_error("distributed_aerofoil_preconditioner: the 4 x 4 Schur complement is singular");
+  }
+
+  Eigen::Index rows() const { return d_ ? d_->local_size() : 0; }
+
+  void apply(const vec<C>& r, vec<C>& z) const {
+    const Eigen::Index nf = d_->flow_size();
+    z.resize(r.size());
+    vec<C> yf(nf);
+    ilu_.apply(vec<C>(r.head(nf)), yf);
+    vec<C> t = sf_ * yf;
+    d_->sum(t.data(), distributed_aerofoil::ns);
+    const vec<C> rs = d_->structure_of(r);
+    const Eigen::Vector4cd rhs = rs - t;
+    const vec<C> zs = lu_.solve(rhs);
+    z.head(nf) = yf - y_ * zs;
+    if (d_->rank() == distributed_aerofoil::root) z.tail(distributed_aerofoil::ns) = zs;
+    else z.tail(distributed_aerofoil::ns).setZero();
+  }
+
+ private:
+  distributed_aerofoil* d_ = nullptr;
+  block_ilu<C, distributed_aerofoil::nv> ilu_;
+  Eigen::MatrixXcd y_, sf_;
+  Eigen::PartialPivLU<Eigen::Matrix4cd> lu_;
+};
+
+/// The eigenpair of the aeroelastic Jacobian J (rows `a`) nearest `shift` on the ranks: the one
+/// inverse-power iteration (bifurcation/inverse_power.hpp) with sums over the ranks, each solve
+/// complex GMRES on J - sigma I preconditioned by distributed_aerofoil_preconditioner of `pre`
+/// (the modified-order rows; nullptr: `a`). `start`: this rank's part (nullptr: the part of the
+/// serial default start). The vector of the result is this rank's part (structure on the
+/// root). Collective; errors as distributed::inverse_power (mpi_eigen.hpp).
+inline eigen_pair inverse_power(distributed_aerofoil& d, const distributed_aerofoil::jacobian_rows& a,
+                                const distributed_aerofoil::jacobian_rows* pre, std::complex<double> shift,
+                                const distributed_inverse_power_options& opt = {},
+                                const vec<std::complex<double>>* start = nullptr) {
+  using C = std::complex<double>;
+  constexpr int nv = distributed_aerofoil::nv;
+  const char* who = "distributed inverse power (aeroelastic)";
+  const MPI_Comm comm = d.communicator();
+  const distributed_vectors space{comm};
+  vec<double> row_sums;
+  internal::collective(comm, who, [&] {
+    require(std::isfinite(shift.real()) && std::isfinite(shift.imag()), who, ": shift ", shift, " is not finite");
+    require(opt.power.max_iterations >= 1 && std::isfinite(opt.power.tolerance) && opt.power.tolerance > 0, who,
+            ": need max_iterations >= 1 and a finite tolerance > 0");
+    if (start) {
+      require_size(start->size(), d.local_size(), who, "start vector (this rank's part)");
+      require_finite(*start, who, "start vector");
+    }
+    const auto& fv = a.flow.values();
+    require(std::all_of(fv.begin(), fv.end(), [](double v) { return std::isfinite(v); }) &&
+                a.flow_structure.allFinite() && a.structure_flow.allFinite() && a.structure.allFinite(),
+            who, ": a Jacobian entry is not finite");
+    row_sums = vec<double>::Zero(d.flow_size());
+    for (Eigen::Index i = 0; i < a.flow.block_rows(); ++i)
+      for (auto p = a.flow.row_ptr()[i]; p < a.flow.row_ptr()[i + 1]; ++p)
+        row_sums.segment(i * nv, nv) += a.flow.block_at(p).cwiseAbs().rowwise().sum();
+    row_sums += a.flow_structure.cwiseAbs().rowwise().sum();
+  });
+  double a_norm = row_sums.size() ? row_sums.maxCoeff() : 0.0;
+  Eigen::Vector4d border = a.structure_flow.cwiseAbs().rowwise().sum();
+  d.sum(border.data(), 4);
+  internal::check_mpi(MPI_Allreduce(MPI_IN_PLACE, &a_norm, 1, MPI_DOUBLE, MPI_MAX, comm), "MPI_Allreduce");
+  a_norm = std::max(a_norm, (border + a.structure.cwiseAbs().rowwise().sum()).maxCoeff());
+
+  vec<C> x;
+  if (start) {
+    x = *start;
+  } else {
+    const vec<C> g = aerohopf::internal::default_start(d.flow().model().size() + distributed_aerofoil::ns);
+    x.resize(d.local_size());
+    x.real() = d.local_part(vec<double>(g.real()));
+    x.imag() = d.local_part(vec<double>(g.imag()));
+  }
+  const double nx2 = space.squared_norm(x);
+  internal::collective(comm, who, [&] { require(nx2 > 0, who, ": start vector is zero"); });
+  x /= std::sqrt(nx2);
+
+  block_ilu_options io;
+  io.fill_level = opt.fill_level;
+  io.context = "distributed inverse power (aeroelastic): block-Jacobi BILU of P - sigma I";
+  distributed_aerofoil_preconditioner pc(io);
+  pc.compute(d, pre ? *pre : a, shift);
+  const distributed_aerofoil_operator op(d, a, shift);
+  krylov_options ko = opt.linear;
+  ko.throw_on_failure = true;
+  return aerohopf::internal::inverse_power_iteration(
+      space, [&](const vec<C>& v) { return d.multiply(a, v); },
+      [&](const vec<C>& v, long& linear_iterations) {
+        vec<C> y = vec<C>::Zero(v.size());
+        linear_iterations += gmres(op, pc, v, y, ko).iterations;
+        return y;
+      },
+      shift, a_norm, std::move(x), opt.power, who);
+}
+
+}  // namespace aerohopf::distributed

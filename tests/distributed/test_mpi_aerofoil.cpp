@@ -1,0 +1,141 @@
+// The pitch-plunge aerofoil on MPI ranks (distributed/mpi_aerofoil.hpp), run by CTest under mpirun
+// on 2 and 3 ranks. Reference: the serial aerofoil_system on the same coarse C-grid. Checked at a
+// perturbed flow with the section displaced and moving (the grid moved and with grid speeds):
+// the gathered residual equals the serial one (flow rows bitwise, the structural rates to
+// rounding: their loads are summed in another order); the bordered Jacobian in the ranks' rows,
+// exact and modified-order, applied to a vector equals the serial bordered Jacobian's product;
+// the structural part counts once in a sum over the ranks; also at the section at rest (the
+// rest grid); the eigenvalue of a structural mode by inverse power on the ranks equals the serial
+// sparse-LU inverse power's; a bad local size is refused on every rank.
+#include <gtest/gtest.h>
+#include <mpi.h>
+
+#include <aerohopf/bifurcation/inverse_power.hpp>
+#include <aerohopf/distributed/mpi_aerofoil.hpp>
+
+#include <complex>
+
+#include <iostream>
+#include <string>
+
+#include "support/error_messages.hpp"
+#include "support/partition_grids.hpp"
+
+using namespace aerohopf;
+using namespace aerohopf::distributed;
+
+namespace {
+
+int world_size() {
+  int n = 0;
+  MPI_Comm_size(MPI_COMM_WORLD, &n);
+  return n;
+}
+
+models::aerofoil_system make_system() {
+  return models::aerofoil_system(flow::euler_model<2>(test::partition_cgrid(), {.mach = 0.8, .alpha_rad = 0.0}),
+                                 structure::pitch_plunge{});
+}
+
+void check_at(const models::aerofoil_system& sys, distributed_aerofoil& d, const Eigen::Vector4d& ws, double ubar) {
+  vec<double> w(sys.size());
+  w.head(sys.flow_size()) = test::perturbed_free_stream(sys.flow(), 3u);
+  w.tail(4) = ws;
+  const vec<double> local = d.local_part(w);
+  EXPECT_EQ(d.all_gather(local), w);
+
+  const vec<double> r_serial = sys.residual(w, ubar);
+  const vec<double> r = d.all_gather(d.residual(local, ubar));
+  EXPECT_EQ(r.head(sys.flow_size()), r_serial.head(sys.flow_size())) << "flow rows";
+  EXPECT_LT((r.tail(4) - r_serial.tail(4)).cwiseAbs().maxCoeff(), 1e-13 * r_serial.tail(4).cwiseAbs().maxCoeff());
+
+  vec<double> x(sys.size());
+  x.head(sys.flow_size()) = test::perturbed_free_stream(sys.flow(), 9u) - sys.flow().free_stream_vector();
+  x.tail(4) << 0.3, -0.2, 0.5, 0.1;
+  const auto pair = sys.bordered_jacobians(w, ubar);
+  for (const auto kind : {flow::jacobian_kind::exact, flow::jacobian_kind::modified_order}) {
+    const auto& serial = kind == flow::jacobian_kind::exact ? pair.exact : pair.preconditioning;
+    vec<double> ref(sys.size());
+    serial.apply(x, ref);
+    distributed_aerofoil::jacobian_rows j;
+    d.jacobian(local, ubar, kind, j);
+    const vec<double> y = d.all_gather(d.multiply(j, d.local_part(x)));
+    const double scale = ref.cwiseAbs().maxCoeff();
+    EXPECT_LT((y.head(sys.flow_size()) - ref.head(sys.flow_size())).cwiseAbs().maxCoeff(), 1e-13 * scale);
+    EXPECT_LT((y.tail(4) - ref.tail(4)).cwiseAbs().maxCoeff(), 1e-13 * ref.tail(4).cwiseAbs().maxCoeff())
+        << "structural rows";
+    EXPECT_EQ(j.structure, serial.structure());
+  }
+  // the structure counts once in a sum over the ranks
+  const vec<double> lx = d.local_part(x);
+  double s = lx.squaredNorm();
+  MPI_Allreduce(MPI_IN_PLACE, &s, 1, MPI_DOUBLE, MPI_SUM, MPI_COMM_WORLD);
+  EXPECT_NEAR(s, x.squaredNorm(), 1e-13 * x.squaredNorm());
+}
+
+}  // namespace
+
+TEST(mpi_aerofoil, residual_and_bordered_jacobian_equal_the_serial_ones) {
+  const models::aerofoil_system sys = make_system();
+  distributed_aerofoil d(sys, partition_blocks(sys.flow(), world_size()), MPI_COMM_WORLD);
+  check_at(sys, d, Eigen::Vector4d(0.01, 0.02, 0.03, -0.01), 4.5);  // displaced and moving
+  check_at(sys, d, Eigen::Vector4d::Zero(), 4.5);                    // at rest: the rest grid
+  check_at(sys, d, Eigen::Vector4d(-0.02, 0.0, -0.01, 0.005), 3.0);  // moved again
+  if (d.rank() == 0) std::cout << world_size() << " ranks: aeroelastic residual and Jacobian rows checked\n";
+}
+
+// The aeroelastic eigenvalue near 0.13 + 0.35i at Ubar = 3 (a structural mode, |x_s| = 0.13 of
+// the unit eigenvector, on this very coarse grid) by inverse power on the ranks (GMRES with the
+// block-Jacobi BILU and the border eliminated) against the serial inverse power with the sparse
+// LU of the whole Jacobian.
+TEST(mpi_aerofoil, inverse_power_equals_the_serial_sparse_lu_iteration) {
+  using cd = std::complex<double>;
+  const models::aerofoil_system sys = make_system();
+  const vec<double> w0 = sys.steady_equilibrium();
+  const double ubar = 3.0;
+  const cd shift(0.13, 0.35);
+  inverse_power_options po;
+  po.tolerance = 1e-10;
+  const eigen_pair ref = aerohopf::inverse_power(sys.jacobian(w0, ubar), shift, po);
+
+  distributed_aerofoil d(sys, partition_blocks(sys.flow(), world_size()), MPI_COMM_WORLD);
+  const vec<double> local = d.local_part(w0);
+  distributed_aerofoil::jacobian_rows a, p;
+  d.jacobian(local, ubar, flow::jacobian_kind::exact, a);
+  d.jacobian(local, ubar, flow::jacobian_kind::modified_order, p);
+  distributed_inverse_power_options o;
+  o.power = po;
+  const eigen_pair ep = distributed::inverse_power(d, a, &p, shift, o);
+  EXPECT_LT(std::abs(ep.lambda - ref.lambda), 1e-10 * std::abs(ref.lambda)) << ep.lambda << " vs " << ref.lambda;
+  const vec<double> xr = d.all_gather(vec<double>(ep.vector.real())), xi = d.all_gather(vec<double>(ep.vector.imag()));
+  vec<cd> x(xr.size());
+  x.real() = xr;
+  x.imag() = xi;
+  EXPECT_LT((x - ref.vector).norm(), 1e-7);
+  EXPECT_GT(x.tail(4).norm(), 0.1);  // a structural mode
+  if (d.rank() == 0)
+    std::cout << world_size() << " ranks: aeroelastic lambda " << ep.lambda << " in " << ep.iterations << " iterations, "
+              << ep.linear_iterations << " GMRES iterations (serial sparse LU: " << ref.lambda << ", " << ref.iterations
+              << " iterations)\n";
+}
+
+TEST(mpi_aerofoil, bad_local_size_is_refused_on_every_rank) {
+  const models::aerofoil_system sys = make_system();
+  distributed_aerofoil d(sys, partition_blocks(sys.flow(), world_size()), MPI_COMM_WORLD);
+  const vec<double> local = d.local_part(sys.free_stream_state());
+  const int last = world_size() - 1;
+  const vec<double> bad = d.rank() == last ? vec<double>(local.head(local.size() - 1)) : local;
+  const std::string msg = test::input_error_of([&] { (void)d.residual(bad, 4.0); });
+  EXPECT_TRUE(test::contains(msg, d.rank() == last ? "local vector" : "refused on rank")) << msg;
+  EXPECT_EQ(d.residual(local, 4.0).size(), local.size());  // and the ranks carry on
+}
+
+int main(int argc, char** argv) {
+  MPI_Init(&argc, &argv);
+  ::testing::InitGoogleTest(&argc, argv);
+  const int failed = RUN_ALL_TESTS();
+  int any = 0;
+  MPI_Allreduce(&failed, &any, 1, MPI_INT, MPI_MAX, MPI_COMM_WORLD);
+  MPI_Finalize();
+  return any;
+}
