@@ -6,7 +6,8 @@
 // exact and modified-order, applied to a vector equals the serial bordered Jacobian's product;
 // the structural part counts once in a sum over the ranks; also at the section at rest (the
 // rest grid); the eigenvalue of a structural mode by inverse power on the ranks equals the serial
-// sparse-LU inverse power's; a bad local size is refused on every rank.
+// sparse-LU inverse power's, and its root locus over Ubar the serial root_locus's; a bad local
+// size is refused on every rank.
 #include <gtest/gtest.h>
 #include <mpi.h>
 
@@ -14,6 +15,8 @@
 #include <aerohopf/distributed/mpi_aerofoil.hpp>
 
 #include <complex>
+#include <functional>
+#include <vector>
 
 #include <iostream>
 #include <string>
@@ -117,6 +120,35 @@ TEST(mpi_aerofoil, inverse_power_equals_the_serial_sparse_lu_iteration) {
     std::cout << world_size() << " ranks: aeroelastic lambda " << ep.lambda << " in " << ep.iterations << " iterations, "
               << ep.linear_iterations << " GMRES iterations (serial sparse LU: " << ref.lambda << ", " << ref.iterations
               << " iterations)\n";
+}
+
+// The root locus of that mode from Ubar = 3 down to 2.7 on the ranks against the serial
+// root_locus (sparse LU), the equilibrium the steady flow with the section at rest.
+TEST(mpi_aerofoil, root_locus_equals_the_serial_one) {
+  using cd = std::complex<double>;
+  const models::aerofoil_system sys = make_system();
+  const vec<double> w0 = sys.steady_equilibrium();
+  const std::vector<double> ubars{3.0, 2.9, 2.8, 2.7};
+  inverse_power_options po;
+  po.tolerance = 1e-10;
+  const auto ref = aerohopf::root_locus(sys, std::function<vec<double>(double)>([&](double) { return w0; }), ubars,
+                                        cd(0.13, 0.35), po);
+  distributed_aerofoil d(sys, partition_blocks(sys.flow(), world_size()), MPI_COMM_WORLD);
+  const vec<double> local = d.local_part(w0);
+  distributed_inverse_power_options o;
+  o.power = po;
+  const auto locus = distributed::root_locus(d, [&](double) { return local; }, ubars, cd(0.13, 0.35), o);
+  ASSERT_EQ(locus.size(), ref.size());
+  for (std::size_t k = 0; k < ref.size(); ++k) {
+    EXPECT_EQ(locus[k].mu, ref[k].mu);
+    EXPECT_LT(std::abs(locus[k].lambda - ref[k].lambda), 1e-8 * std::abs(ref[k].lambda))
+        << "Ubar " << ref[k].mu << ": " << locus[k].lambda << " vs " << ref[k].lambda;
+    if (d.rank() == 0)
+      std::cout << world_size() << " ranks: Ubar " << ref[k].mu << "  lambda " << locus[k].lambda << " (serial "
+                << ref[k].lambda << "), " << locus[k].iterations << " iterations\n";
+  }
+  // a NaN Ubar is refused before any point is computed, on every rank
+  EXPECT_THROW(distributed::root_locus(d, [&](double) { return local; }, {3.0, NAN}, cd(0.13, 0.35), o), input_error);
 }
 
 TEST(mpi_aerofoil, bad_local_size_is_refused_on_every_rank) {

@@ -26,6 +26,7 @@
 
 #include <mpi.h>
 
+#include <aerohopf/bifurcation/root_locus.hpp>
 #include <aerohopf/distributed/mpi_eigen.hpp>
 #include <aerohopf/distributed/mpi_euler.hpp>
 #include <aerohopf/linalg/block_ilu.hpp>
@@ -39,6 +40,7 @@
 #include <array>
 #include <cmath>
 #include <complex>
+#include <functional>
 #include <type_traits>
 #include <string>
 #include <vector>
@@ -219,6 +221,16 @@ class distributed_aerofoil {
     return s;
   }
 
+  /// Throws input_error on every rank unless every rank's `local` has local_size() finite
+  /// entries and ubar is finite (collective).
+  void check_state(const vec<double>& local, double ubar, const char* who) const {
+    internal::collective(comm_, who, [&] {
+      require(std::isfinite(ubar), who, ": Ubar ", ubar, " is not finite");
+      require_size(local.size(), local_size(), who, "state (this rank's flow values and 4 structural)");
+      require_finite(local, who, "state (this rank's part)");
+    });
+  }
+
   /// In-place sum over the ranks (collective).
   void sum(double* p, int n) const {
     internal::check_mpi(MPI_Allreduce(MPI_IN_PLACE, p, n, MPI_DOUBLE, MPI_SUM, comm_), "MPI_Allreduce");
@@ -397,6 +409,25 @@ inline eigen_pair inverse_power(distributed_aerofoil& d, const distributed_aerof
         return y;
       },
       shift, a_norm, std::move(x), opt.power, who);
+}
+
+/// The root locus (bifurcation/root_locus.hpp, the same loop) on the ranks: equilibrium(Ubar)
+/// returns this rank's part of w0(Ubar) (e.g. the distributed steady solve's, or local_part of
+/// a known state); each point's eigenpair by inverse_power above, from the previous point's
+/// eigenvalue (shift) and eigenvector part (start). Collective; errors as root_locus.
+inline std::vector<root_locus_point> root_locus(distributed_aerofoil& d,
+                                                const std::function<vec<double>(double)>& equilibrium,
+                                                const std::vector<double>& ubars, std::complex<double> shift0,
+                                                const distributed_inverse_power_options& opt = {}) {
+  distributed_aerofoil::jacobian_rows a, p;
+  return aerohopf::internal::root_locus_loop(
+      equilibrium, [&d](const vec<double>& w, double ubar) { d.check_state(w, ubar, "distributed root_locus"); },
+      [&](double ubar, const vec<double>& w, std::complex<double> shift, const vec<std::complex<double>>* start) {
+        d.jacobian(w, ubar, flow::jacobian_kind::exact, a);
+        d.jacobian(w, ubar, flow::jacobian_kind::modified_order, p);
+        return inverse_power(d, a, &p, shift, opt, start);
+      },
+      ubars, shift0, opt.power, "distributed root_locus");
 }
 
 }  // namespace aerohopf::distributed
