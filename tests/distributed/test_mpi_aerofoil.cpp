@@ -13,6 +13,7 @@
 
 #include <aerohopf/bifurcation/inverse_power.hpp>
 #include <aerohopf/distributed/mpi_aerofoil.hpp>
+#include <aerohopf/distributed/mpi_steady.hpp>
 
 #include <complex>
 #include <functional>
@@ -122,8 +123,9 @@ TEST(mpi_aerofoil, inverse_power_equals_the_serial_sparse_lu_iteration) {
               << " iterations)\n";
 }
 
-// The root locus of that mode from Ubar = 3 down to 2.7 on the ranks against the serial
-// root_locus (sparse LU), the equilibrium the steady flow with the section at rest.
+// The root locus of that mode from Ubar = 3 down to 2.7 on the ranks, its equilibrium (the
+// steady flow with the section at rest) by the steady solve on the ranks, against the serial
+// root_locus (sparse LU) on the serial equilibrium.
 TEST(mpi_aerofoil, root_locus_equals_the_serial_one) {
   using cd = std::complex<double>;
   const models::aerofoil_system sys = make_system();
@@ -134,7 +136,16 @@ TEST(mpi_aerofoil, root_locus_equals_the_serial_one) {
   const auto ref = aerohopf::root_locus(sys, std::function<vec<double>(double)>([&](double) { return w0; }), ubars,
                                         cd(0.13, 0.35), po);
   distributed_aerofoil d(sys, partition_blocks(sys.flow(), world_size()), MPI_COMM_WORLD);
-  const vec<double> local = d.local_part(w0);
+  // the equilibrium by the steady solve on the ranks (the flow with the section at rest; the
+  // same partition, so the same local order as d's flow part)
+  flow::euler_model<2> fm = sys.flow();
+  distributed_euler<2> de(fm, partition_blocks(fm, world_size()), MPI_COMM_WORLD);
+  distributed_euler_discretisation<2> disc(fm, de);
+  vec<double> wf = de.local_part(fm.free_stream_vector());
+  ASSERT_TRUE(flow::solve_steady(disc, wf, {}).converged);
+  vec<double> local = vec<double>::Zero(d.local_size());
+  local.head(d.flow_size()) = wf;
+  EXPECT_LT((d.all_gather(local) - w0).cwiseAbs().maxCoeff(), 1e-9 * w0.cwiseAbs().maxCoeff());
   distributed_inverse_power_options o;
   o.power = po;
   const auto locus = distributed::root_locus(d, [&](double) { return local; }, ubars, cd(0.13, 0.35), o);
