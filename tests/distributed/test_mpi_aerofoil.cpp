@@ -7,7 +7,7 @@
 // the structural part counts once in a sum over the ranks; also at the section at rest (the
 // rest grid); the eigenvalue of a structural mode by inverse power on the ranks equals the serial
 // sparse-LU inverse power's, and its root locus over Ubar the serial root_locus's; a bad local
-// size is refused on every rank.
+// size, a NaN entry or a NaN Ubar is refused on every rank.
 #include <gtest/gtest.h>
 #include <mpi.h>
 
@@ -23,18 +23,15 @@
 #include <string>
 
 #include "support/error_messages.hpp"
+#include "support/mpi_test.hpp"
 #include "support/partition_grids.hpp"
 
 using namespace aerohopf;
 using namespace aerohopf::distributed;
+using aerohopf::test::world_size;
 
 namespace {
 
-int world_size() {
-  int n = 0;
-  MPI_Comm_size(MPI_COMM_WORLD, &n);
-  return n;
-}
 
 models::aerofoil_system make_system() {
   return models::aerofoil_system(flow::euler_model<2>(test::partition_cgrid(), {.mach = 0.8, .alpha_rad = 0.0}),
@@ -162,23 +159,20 @@ TEST(mpi_aerofoil, root_locus_equals_the_serial_one) {
   EXPECT_THROW(distributed::root_locus(d, [&](double) { return local; }, {3.0, NAN}, cd(0.13, 0.35), o), input_error);
 }
 
-TEST(mpi_aerofoil, bad_local_size_is_refused_on_every_rank) {
+TEST(mpi_aerofoil, bad_input_is_refused_on_every_rank) {
   const models::aerofoil_system sys = make_system();
   distributed_aerofoil d(sys, partition_blocks(sys.flow(), world_size()), MPI_COMM_WORLD);
   const vec<double> local = d.local_part(sys.free_stream_state());
   const int last = world_size() - 1;
   const vec<double> bad = d.rank() == last ? vec<double>(local.head(local.size() - 1)) : local;
   const std::string msg = test::input_error_of([&] { (void)d.residual(bad, 4.0); });
-  EXPECT_TRUE(test::contains(msg, d.rank() == last ? "local vector" : "refused on rank")) << msg;
+  EXPECT_TRUE(test::contains(msg, d.rank() == last ? "this rank's flow values" : "refused on rank")) << msg;
+  // a NaN Ubar, and a NaN state entry on rank 0 only
+  EXPECT_THROW((void)d.residual(local, NAN), input_error);
+  vec<double> nan_state = local;
+  if (d.rank() == 0) nan_state[1] = NAN;
+  EXPECT_THROW((void)d.residual(nan_state, 4.0), input_error);
   EXPECT_EQ(d.residual(local, 4.0).size(), local.size());  // and the ranks carry on
 }
 
-int main(int argc, char** argv) {
-  MPI_Init(&argc, &argv);
-  ::testing::InitGoogleTest(&argc, argv);
-  const int failed = RUN_ALL_TESTS();
-  int any = 0;
-  MPI_Allreduce(&failed, &any, 1, MPI_INT, MPI_MAX, MPI_COMM_WORLD);
-  MPI_Finalize();
-  return any;
-}
+int main(int argc, char** argv) { return aerohopf::test::run_tests_on_ranks(argc, argv); }

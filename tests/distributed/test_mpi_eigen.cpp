@@ -16,19 +16,16 @@
 #include <iostream>
 
 #include "support/error_messages.hpp"
+#include "support/mpi_test.hpp"
 #include "support/partition_grids.hpp"
 
 using namespace aerohopf;
 using namespace aerohopf::distributed;
+using aerohopf::test::world_size;
 using cd = std::complex<double>;
 
 namespace {
 
-int world_size() {
-  int n = 0;
-  MPI_Comm_size(MPI_COMM_WORLD, &n);
-  return n;
-}
 
 struct flow_case {
   flow::euler_model<2> m{test::partition_cgrid(), {.mach = 0.8, .alpha_rad = 1.25 * M_PI / 180.0}};
@@ -110,12 +107,4 @@ TEST(mpi_eigen, bad_input_is_refused_on_every_rank) {
   EXPECT_THROW(distributed::inverse_power(d, bad, nullptr, cd(0, 0.1)), input_error);
 }
 
-int main(int argc, char** argv) {
-  MPI_Init(&argc, &argv);
-  ::testing::InitGoogleTest(&argc, argv);
-  const int failed = RUN_ALL_TESTS();
-  int any = 0;
-  MPI_Allreduce(&failed, &any, 1, MPI_INT, MPI_MAX, MPI_COMM_WORLD);
-  MPI_Finalize();
-  return any;
-}
+int main(int argc, char** argv) { return aerohopf::test::run_tests_on_ranks(argc, argv); }

@@ -19,20 +19,17 @@
 
 #include <string>
 #include "support/error_messages.hpp"
+#include "support/mpi_test.hpp"
 #include "support/partition_grids.hpp"
 #include "support/wing_cases.hpp"
 
 using namespace aerohopf;
 using namespace aerohopf::distributed;
+using aerohopf::test::world_size;
 using aerohopf::test::contains;
 
 namespace {
 
-int world_size() {
-  int n = 0;
-  MPI_Comm_size(MPI_COMM_WORLD, &n);
-  return n;
-}
 
 template <int Dim>
 void check_residual(const flow::euler_model<Dim>& m) {
@@ -190,12 +187,4 @@ TEST(mpi_euler, errors_are_collective) {
   EXPECT_THROW(distributed_euler<2>(m, wrong, MPI_COMM_WORLD), input_error);
 }
 
-int main(int argc, char** argv) {
-  MPI_Init(&argc, &argv);
-  ::testing::InitGoogleTest(&argc, argv);
-  const int failed = RUN_ALL_TESTS();
-  int any = 0;
-  MPI_Allreduce(&failed, &any, 1, MPI_INT, MPI_MAX, MPI_COMM_WORLD);
-  MPI_Finalize();
-  return any;
-}
+int main(int argc, char** argv) { return aerohopf::test::run_tests_on_ranks(argc, argv); }

@@ -19,19 +19,16 @@
 #include <iostream>
 
 #include "support/error_messages.hpp"
+#include "support/mpi_test.hpp"
 #include "support/partition_grids.hpp"
 #include "support/wing_cases.hpp"
 
 using namespace aerohopf;
 using namespace aerohopf::distributed;
+using aerohopf::test::world_size;
 
 namespace {
 
-int world_size() {
-  int n = 0;
-  MPI_Comm_size(MPI_COMM_WORLD, &n);
-  return n;
-}
 
 /// shift I - J (modified order) at a perturbed free stream: whole (serial) and this rank's rows.
 template <int Dim>
@@ -132,13 +129,6 @@ TEST(mpi_petsc, bad_input_is_refused_on_every_rank) {
 }
 
 int main(int argc, char** argv) {
-  MPI_Init(&argc, &argv);
-  PetscInitialize(&argc, &argv, nullptr, nullptr);
-  ::testing::InitGoogleTest(&argc, argv);
-  const int failed = RUN_ALL_TESTS();
-  int any = 0;
-  MPI_Allreduce(&failed, &any, 1, MPI_INT, MPI_MAX, MPI_COMM_WORLD);
-  PetscFinalize();
-  MPI_Finalize();
-  return any;
+  return aerohopf::test::run_tests_on_ranks(
+      argc, argv, [](int& c, char**& v) { PetscInitialize(&c, &v, nullptr, nullptr); }, [] { PetscFinalize(); });
 }

@@ -16,21 +16,14 @@
 #include <iostream>
 
 #include "support/error_messages.hpp"
+#include "support/mpi_test.hpp"
 #include "support/partition_grids.hpp"
 
 using namespace aerohopf;
 using namespace aerohopf::distributed;
+using aerohopf::test::world_size;
 using cd = std::complex<double>;
 
-namespace {
-
-int world_size() {
-  int n = 0;
-  MPI_Comm_size(MPI_COMM_WORLD, &n);
-  return n;
-}
-
-}  // namespace
 
 TEST(mpi_slepc, inverse_power_finds_the_eigenvalues_slepc_finds) {
   flow::euler_model<2> m(test::partition_cgrid(), {.mach = 0.8, .alpha_rad = 1.25 * M_PI / 180.0});
@@ -80,13 +73,6 @@ TEST(mpi_slepc, bad_input_is_refused_on_every_rank) {
 }
 
 int main(int argc, char** argv) {
-  MPI_Init(&argc, &argv);
-  SlepcInitialize(&argc, &argv, nullptr, nullptr);
-  ::testing::InitGoogleTest(&argc, argv);
-  const int failed = RUN_ALL_TESTS();
-  int any = 0;
-  MPI_Allreduce(&failed, &any, 1, MPI_INT, MPI_MAX, MPI_COMM_WORLD);
-  SlepcFinalize();
-  MPI_Finalize();
-  return any;
+  return aerohopf::test::run_tests_on_ranks(
+      argc, argv, [](int& c, char**& v) { SlepcInitialize(&c, &v, nullptr, nullptr); }, [] { SlepcFinalize(); });
 }

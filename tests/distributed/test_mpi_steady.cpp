@@ -16,20 +16,17 @@
 #include <string>
 
 #include "support/error_messages.hpp"
+#include "support/mpi_test.hpp"
 #include "support/partition_grids.hpp"
 #include "support/wing_cases.hpp"
 
 using namespace aerohopf;
 using namespace aerohopf::distributed;
+using aerohopf::test::world_size;
 using aerohopf::test::contains;
 
 namespace {
 
-int world_size() {
-  int n = 0;
-  MPI_Comm_size(MPI_COMM_WORLD, &n);
-  return n;
-}
 
 /// Serial and distributed solves of m from the free stream; the states agree to `tol` relative
 /// (max norm), cl and cm to `tol` absolute.
@@ -138,12 +135,4 @@ TEST(mpi_steady, failures_are_the_same_on_every_rank) {
   EXPECT_TRUE(flow::solve_steady(disc, w, flow::steady_options{}).converged);
 }
 
-int main(int argc, char** argv) {
-  MPI_Init(&argc, &argv);
-  ::testing::InitGoogleTest(&argc, argv);
-  const int failed = RUN_ALL_TESTS();
-  int any = 0;
-  MPI_Allreduce(&failed, &any, 1, MPI_INT, MPI_MAX, MPI_COMM_WORLD);
-  MPI_Finalize();
-  return any;
-}
+int main(int argc, char** argv) { return aerohopf::test::run_tests_on_ranks(argc, argv); }

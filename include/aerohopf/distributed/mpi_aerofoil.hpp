@@ -92,7 +92,7 @@ class distributed_aerofoil {
 
   /// f(w, Ubar) in this rank's part (collective).
   vec<double> residual(const vec<double>& local, double ubar) {
-    check_local(local, "distributed_aerofoil::residual");
+    check_state(local, ubar, "distributed_aerofoil::residual");
     const Eigen::Vector4d ws = structure_of(local);
     const coupling::rigid_pose<double> q{ws[0], ws[1], ws[2], ws[3]};
     const auto m = sys_.moved_metrics<double>(q);
@@ -116,7 +116,7 @@ class distributed_aerofoil {
   /// The exact (kind exact) or modified-order Jacobian in this rank's rows at (w, Ubar)
   /// (collective). The border is the same for both kinds.
   void jacobian(const vec<double>& local, double ubar, flow::jacobian_kind kind, jacobian_rows& j) {
-    check_local(local, "distributed_aerofoil::jacobian");
+    check_state(local, ubar, "distributed_aerofoil::jacobian");
     const Eigen::Vector4d ws = structure_of(local);
     const vec<double> wf = local.head(flow_size());
     // A_ff on the grid moved to ws, as the serial assembly (the rest model when ws = 0)
@@ -354,7 +354,6 @@ inline eigen_pair inverse_power(distributed_aerofoil& d, const distributed_aerof
   constexpr int nv = distributed_aerofoil::nv;
   const char* who = "distributed inverse power (aeroelastic)";
   const MPI_Comm comm = d.communicator();
-  const distributed_vectors space{comm};
   vec<double> row_sums;
   internal::collective(comm, who, [&] {
     require(std::isfinite(shift.real()) && std::isfinite(shift.imag()), who, ": shift ", shift, " is not finite");
@@ -380,35 +379,16 @@ inline eigen_pair inverse_power(distributed_aerofoil& d, const distributed_aerof
   internal::check_mpi(MPI_Allreduce(MPI_IN_PLACE, &a_norm, 1, MPI_DOUBLE, MPI_MAX, comm), "MPI_Allreduce");
   a_norm = std::max(a_norm, (border + a.structure.cwiseAbs().rowwise().sum()).maxCoeff());
 
-  vec<C> x;
-  if (start) {
-    x = *start;
-  } else {
-    const vec<C> g = aerohopf::internal::default_start(d.flow().model().size() + distributed_aerofoil::ns);
-    x.resize(d.local_size());
-    x.real() = d.local_part(vec<double>(g.real()));
-    x.imag() = d.local_part(vec<double>(g.imag()));
-  }
-  const double nx2 = space.squared_norm(x);
-  internal::collective(comm, who, [&] { require(nx2 > 0, who, ": start vector is zero"); });
-  x /= std::sqrt(nx2);
-
   block_ilu_options io;
   io.fill_level = opt.fill_level;
   io.context = "distributed inverse power (aeroelastic): block-Jacobi BILU of P - sigma I";
   distributed_aerofoil_preconditioner pc(io);
   pc.compute(d, pre ? *pre : a, shift);
   const distributed_aerofoil_operator op(d, a, shift);
-  krylov_options ko = opt.linear;
-  ko.throw_on_failure = true;
-  return aerohopf::internal::inverse_power_iteration(
-      space, [&](const vec<C>& v) { return d.multiply(a, v); },
-      [&](const vec<C>& v, long& linear_iterations) {
-        vec<C> y = vec<C>::Zero(v.size());
-        linear_iterations += gmres(op, pc, v, y, ko).iterations;
-        return y;
-      },
-      shift, a_norm, std::move(x), opt.power, who);
+  return internal::run_inverse_power(
+      comm, start, d.flow().model().size() + distributed_aerofoil::ns,
+      [&d](const vec<double>& g) { return d.local_part(g); }, [&](const vec<C>& v) { return d.multiply(a, v); }, op,
+      pc, shift, a_norm, opt, who);
 }
 
 /// The root locus (bifurcation/root_locus.hpp, the same loop) on the ranks: equilibrium(Ubar)

@@ -73,6 +73,45 @@ struct distributed_inverse_power_options {
   }
 };
 
+namespace internal {
+
+/// The part shared by the distributed inverse powers: the start (`start`, or this rank's part of
+/// the serial default start of n_global entries, by local_part), unit-normalised over the ranks,
+/// then the one iteration with GMRES on `op` preconditioned by `pc` for each solve. Collective.
+template <class LocalPart, class Apply, class Op, class Pc>
+eigen_pair run_inverse_power(MPI_Comm comm, const vec<std::complex<double>>* start, Eigen::Index n_global,
+                             const LocalPart& local_part, const Apply& apply, const Op& op, const Pc& pc,
+                             std::complex<double> shift, double a_norm, const distributed_inverse_power_options& opt,
+                             const char* who) {
+  using C = std::complex<double>;
+  const distributed_vectors space{comm};
+  vec<C> x;
+  if (start) {
+    x = *start;
+  } else {  // this rank's part of the serial default start
+    const vec<C> g = aerohopf::internal::default_start(n_global);
+    const vec<double> re = local_part(vec<double>(g.real())), im = local_part(vec<double>(g.imag()));
+    x.resize(re.size());
+    x.real() = re;
+    x.imag() = im;
+  }
+  const double nx2 = space.squared_norm(x);
+  collective(comm, who, [&] { require(nx2 > 0, who, ": start vector is zero"); });
+  x /= std::sqrt(nx2);
+  krylov_options ko = opt.linear;
+  ko.throw_on_failure = true;
+  return aerohopf::internal::inverse_power_iteration(
+      space, apply,
+      [&](const vec<C>& v, long& linear_iterations) {
+        vec<C> y = vec<C>::Zero(v.size());
+        linear_iterations += gmres(op, pc, v, y, ko).iterations;
+        return y;
+      },
+      shift, a_norm, std::move(x), opt.power, who);
+}
+
+}  // namespace internal
+
 /// The eigenpair of A nearest `shift`: A a matrix of this rank's rows in d's numbering
 /// (distributed_euler::jacobian), `pre` the matrix whose block-Jacobi BILU(k) preconditions the
 /// shifted solves (nullptr: A itself), `start` this rank's part of the start vector (nullptr:
@@ -89,7 +128,6 @@ eigen_pair inverse_power(distributed_euler<Dim>& d, const block_sparse_matrix<do
   constexpr int nv = Dim + 2;
   const char* who = "distributed inverse power";
   const MPI_Comm comm = d.communicator();
-  const distributed_vectors space{comm};
   double a_norm = 0;
   internal::collective(comm, who, [&] {
     require(std::isfinite(shift.real()) && std::isfinite(shift.imag()), who, ": shift ", shift, " is not finite");
@@ -118,35 +156,15 @@ eigen_pair inverse_power(distributed_euler<Dim>& d, const block_sparse_matrix<do
     a_norm = row_sums.size() ? row_sums.maxCoeff() : 0.0;
   });
   internal::check_mpi(MPI_Allreduce(MPI_IN_PLACE, &a_norm, 1, MPI_DOUBLE, MPI_MAX, comm), "MPI_Allreduce");
-  vec<C> x;
-  if (start) {
-    x = *start;
-  } else {  // this rank's part of the serial default start
-    const vec<C> g = aerohopf::internal::default_start(d.model().size());
-    x.resize(d.local_size());
-    x.real() = d.local_part(vec<double>(g.real()));
-    x.imag() = d.local_part(vec<double>(g.imag()));
-  }
-  const double nx2 = space.squared_norm(x);
-  internal::collective(comm, who, [&] { require(nx2 > 0, who, ": start vector is zero"); });
-  x /= std::sqrt(nx2);
-
   block_ilu_options io;
   io.fill_level = opt.fill_level;
   io.context = "distributed inverse power: block-Jacobi BILU of P - sigma I";
   block_ilu<C, nv> ilu(io);
   internal::collective(comm, who, [&] { ilu.compute(shifted(owned_part(pre ? *pre : a), shift)); });
   const distributed_matrix_operator<Dim, C> op(d, a, comm, shift);
-  krylov_options ko = opt.linear;
-  ko.throw_on_failure = true;
-  return aerohopf::internal::inverse_power_iteration(
-      space, [&](const vec<C>& v) { return d.multiply(a, v); },
-      [&](const vec<C>& v, long& linear_iterations) {
-        vec<C> y = vec<C>::Zero(v.size());
-        linear_iterations += gmres(op, ilu, v, y, ko).iterations;
-        return y;
-      },
-      shift, a_norm, std::move(x), opt.power, who);
+  return internal::run_inverse_power(
+      comm, start, d.model().size(), [&d](const vec<double>& g) { return d.local_part(g); },
+      [&](const vec<C>& v) { return d.multiply(a, v); }, op, ilu, shift, a_norm, opt, who);
 }
 
 }  // namespace aerohopf::distributed

@@ -1,0 +1,35 @@
+#pragma once
+// The MPI tests' shared pieces (tests/distributed/test_mpi_*.cpp, run under mpirun on 2 and 3
+// ranks): the number of ranks, and the main that runs GoogleTest on every rank and fails the
+// process on every rank if a test failed on any.
+#include <gtest/gtest.h>
+#include <mpi.h>
+
+namespace aerohopf::test {
+
+inline int world_size() {
+  int n = 0;
+  MPI_Comm_size(MPI_COMM_WORLD, &n);
+  return n;
+}
+
+/// MPI_Init, then init() (e.g. PetscInitialize), the tests, fini(), MPI_Finalize; returns
+/// nonzero on every rank if any rank had a failure.
+template <class Init, class Fini>
+int run_tests_on_ranks(int argc, char** argv, Init init, Fini fini) {
+  MPI_Init(&argc, &argv);
+  init(argc, argv);
+  ::testing::InitGoogleTest(&argc, argv);
+  const int failed = RUN_ALL_TESTS();
+  int any = 0;
+  MPI_Allreduce(&failed, &any, 1, MPI_INT, MPI_MAX, MPI_COMM_WORLD);
+  fini();
+  MPI_Finalize();
+  return any;
+}
+
+inline int run_tests_on_ranks(int argc, char** argv) {
+  return run_tests_on_ranks(argc, argv, [](int, char**) {}, [] {});
+}
+
+}  // namespace aerohopf::test
