@@ -26,7 +26,6 @@ using cd = std::complex<double>;
 
 namespace {
 
-
 struct flow_case {
   flow::euler_model<2> m{test::partition_cgrid(), {.mach = 0.8, .alpha_rad = 1.25 * M_PI / 180.0}};
   vec<double> w;

@@ -30,7 +30,6 @@ using aerohopf::test::contains;
 
 namespace {
 
-
 template <int Dim>
 void check_residual(const flow::euler_model<Dim>& m) {
   distributed_euler<Dim> d(m, partition_blocks(m, world_size()), MPI_COMM_WORLD);

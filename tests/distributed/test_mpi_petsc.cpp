@@ -29,7 +29,6 @@ using aerohopf::test::world_size;
 
 namespace {
 
-
 /// shift I - J (modified order) at a perturbed free stream: whole (serial) and this rank's rows.
 template <int Dim>
 void shifted_system(const flow::euler_model<Dim>& m, distributed_euler<Dim>& d, double shift,

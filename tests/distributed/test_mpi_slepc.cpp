@@ -24,7 +24,6 @@ using namespace aerohopf::distributed;
 using aerohopf::test::world_size;
 using cd = std::complex<double>;
 
-
 TEST(mpi_slepc, inverse_power_finds_the_eigenvalues_slepc_finds) {
   flow::euler_model<2> m(test::partition_cgrid(), {.mach = 0.8, .alpha_rad = 1.25 * M_PI / 180.0});
   vec<double> w = m.free_stream_vector();

@@ -27,7 +27,6 @@ using aerohopf::test::contains;
 
 namespace {
 
-
 /// Serial and distributed solves of m from the free stream; the states agree to `tol` relative
 /// (max norm), cl and cm to `tol` absolute.
 template <int Dim>

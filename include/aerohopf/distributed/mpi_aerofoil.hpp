@@ -127,7 +127,8 @@ class distributed_aerofoil {
       }
     } else {
       flow::multiblock_points<double, 2> pts, spd;
-      coupling::rigid_grid_motion<double>(sys_.flow().grid().points, coupling::rigid_pose<double>{ws[0], ws[1], ws[2], ws[3]},
+      coupling::rigid_grid_motion<double>(sys_.flow().grid().points,
+                                          coupling::rigid_pose<double>{ws[0], ws[1], ws[2], ws[3]},
                                           {sys_.structure().parameters().x_ea, sys_.structure().parameters().y_ea}, pts,
                                           &spd);
       moved_.set_grid_motion(pts, &spd);
@@ -164,7 +165,8 @@ class distributed_aerofoil {
       parts[1 + k] = clj.derivative(k);
       parts[ns + 2 + k] = cmj.derivative(k);
     }
-    internal::check_mpi(MPI_Allreduce(MPI_IN_PLACE, parts.data(), static_cast<int>(parts.size()), MPI_DOUBLE, MPI_SUM, comm_),
+    internal::check_mpi(
+        MPI_Allreduce(MPI_IN_PLACE, parts.data(), static_cast<int>(parts.size()), MPI_DOUBLE, MPI_SUM, comm_),
                         "MPI_Allreduce");
     sjet cl(parts[0]), cm(parts[ns + 1]);
     for (int k = 0; k < ns; ++k) {
@@ -184,6 +186,17 @@ class distributed_aerofoil {
                                 [&](int i, Eigen::Index cell, int v, double x) {
                                   j.structure_flow(i, num.local[static_cast<std::size_t>(cell)] * nv + v) += x;
                                 });
+  }
+
+  /// The exact and the modified-order Jacobian rows at (w, Ubar) together: the border (one jet
+  /// pass) and the moved grid computed once, as aerofoil_system::bordered_jacobians (collective).
+  void jacobians(const vec<double>& local, double ubar, jacobian_rows& exact, jacobian_rows& preconditioning) {
+    jacobian(local, ubar, flow::jacobian_kind::exact, exact);
+    // moved_ is at w's pose now
+    d_.jacobian(local.head(flow_size()), flow::jacobian_kind::modified_order, preconditioning.flow);
+    preconditioning.flow_structure = exact.flow_structure;
+    preconditioning.structure_flow = exact.structure_flow;
+    preconditioning.structure = exact.structure;
   }
 
   /// y = J x in this rank's part, real or complex vectors (collective: the flow's halo, the
@@ -403,8 +416,7 @@ inline std::vector<root_locus_point> root_locus(distributed_aerofoil& d,
   return aerohopf::internal::root_locus_loop(
       equilibrium, [&d](const vec<double>& w, double ubar) { d.check_state(w, ubar, "distributed root_locus"); },
       [&](double ubar, const vec<double>& w, std::complex<double> shift, const vec<std::complex<double>>* start) {
-        d.jacobian(w, ubar, flow::jacobian_kind::exact, a);
-        d.jacobian(w, ubar, flow::jacobian_kind::modified_order, p);
+        d.jacobians(w, ubar, a, p);
         return inverse_power(d, a, &p, shift, opt, start);
       },
       ubars, shift0, opt.power, "distributed root_locus");
