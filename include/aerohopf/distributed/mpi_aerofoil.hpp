@@ -106,7 +106,7 @@ class distributed_aerofoil {
     auto [cl, cm] = sys_.loads_of_blocks<double>(m, coupling::rigid_rotation<double>(ws[2]), full.data(),
                                                  &d_.owned_blocks());
     std::array<double, 2> loads{cl, cm};
-    internal::check_mpi(MPI_Allreduce(MPI_IN_PLACE, loads.data(), 2, MPI_DOUBLE, MPI_SUM, comm_), "MPI_Allreduce");
+    sum(loads.data(), 2);
     const auto rs = sys_.structure().rate<double>(ws, loads[0], loads[1], ubar);
     // element by element: GCC 12 with AVX-512 warns falsely on a fixed-to-dynamic copy
     for (int i = 0; i < ns; ++i) r[flow_size() + i] = d_.rank() == root ? rs[i] : 0.0;
@@ -165,9 +165,7 @@ class distributed_aerofoil {
       parts[1 + k] = clj.derivative(k);
       parts[ns + 2 + k] = cmj.derivative(k);
     }
-    internal::check_mpi(
-        MPI_Allreduce(MPI_IN_PLACE, parts.data(), static_cast<int>(parts.size()), MPI_DOUBLE, MPI_SUM, comm_),
-                        "MPI_Allreduce");
+    sum(parts.data(), static_cast<int>(parts.size()));
     sjet cl(parts[0]), cm(parts[ns + 1]);
     for (int k = 0; k < ns; ++k) {
       cl.derivative(k) = parts[1 + k];
@@ -245,12 +243,8 @@ class distributed_aerofoil {
   }
 
   /// In-place sum over the ranks (collective).
-  void sum(double* p, int n) const {
-    internal::check_mpi(MPI_Allreduce(MPI_IN_PLACE, p, n, MPI_DOUBLE, MPI_SUM, comm_), "MPI_Allreduce");
-  }
-  void sum(std::complex<double>* p, int n) const {
-    internal::check_mpi(MPI_Allreduce(MPI_IN_PLACE, p, n, MPI_C_DOUBLE_COMPLEX, MPI_SUM, comm_), "MPI_Allreduce");
-  }
+  void sum(double* p, int n) const { internal::sum_over_ranks(comm_, p, n); }
+  void sum(std::complex<double>* p, int n) const { internal::sum_over_ranks(comm_, p, n); }
   MPI_Comm communicator() const { return comm_; }
 
  private:

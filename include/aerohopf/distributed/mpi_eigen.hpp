@@ -34,12 +34,12 @@ struct distributed_vectors {
 
   double squared_norm(const vec<std::complex<double>>& v) const {
     double s = v.squaredNorm();
-    internal::check_mpi(MPI_Allreduce(MPI_IN_PLACE, &s, 1, MPI_DOUBLE, MPI_SUM, comm), "MPI_Allreduce");
+    internal::sum_over_ranks(comm, &s, 1);
     return s;
   }
   std::complex<double> dot(const vec<std::complex<double>>& a, const vec<std::complex<double>>& b) const {
     std::complex<double> s = a.dot(b);
-    internal::check_mpi(MPI_Allreduce(MPI_IN_PLACE, &s, 1, MPI_C_DOUBLE_COMPLEX, MPI_SUM, comm), "MPI_Allreduce");
+    internal::sum_over_ranks(comm, &s, 1);
     return s;
   }
   std::complex<double> largest_entry(const vec<std::complex<double>>& x) const {

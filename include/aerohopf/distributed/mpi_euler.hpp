@@ -48,6 +48,14 @@ inline void check_mpi(int code, const char* call) {
   throw std::runtime_error(aerohopf::internal::concat("MPI: ", call, " failed: ", std::string(text, len)));
 }
 
+/// p[0 .. n) summed over the ranks of comm, in place (collective).
+inline void sum_over_ranks(MPI_Comm comm, double* p, int n) {
+  check_mpi(MPI_Allreduce(MPI_IN_PLACE, p, n, MPI_DOUBLE, MPI_SUM, comm), "MPI_Allreduce");
+}
+inline void sum_over_ranks(MPI_Comm comm, std::complex<double>* p, int n) {
+  check_mpi(MPI_Allreduce(MPI_IN_PLACE, p, n, MPI_C_DOUBLE_COMPLEX, MPI_SUM, comm), "MPI_Allreduce");
+}
+
 /// Runs f on every rank; if it throws on any rank, every rank throws (collective).
 template <class F>
 void collective(MPI_Comm comm, const char* what, F&& f) {
@@ -276,7 +284,7 @@ class distributed_euler {
         fm[3 + i] = c.moment[i];
       }
     });
-    internal::check_mpi(MPI_Allreduce(MPI_IN_PLACE, fm.data(), 6, MPI_DOUBLE, MPI_SUM, comm_), "MPI_Allreduce");
+    internal::sum_over_ranks(comm_, fm.data(), 6);
     return model_.coefficients({fm[0], fm[1], fm[2]}, {fm[3], fm[4], fm[5]});
   }
 
@@ -362,12 +370,8 @@ class distributed_matrix_operator {
     y = d_->multiply(*a_, x);
     if (sigma_ != S(0)) y -= sigma_ * x;
   }
-  void global_sum(double* p, int n) const {
-    internal::check_mpi(MPI_Allreduce(MPI_IN_PLACE, p, n, MPI_DOUBLE, MPI_SUM, comm_), "MPI_Allreduce");
-  }
-  void global_sum(std::complex<double>* p, int n) const {
-    internal::check_mpi(MPI_Allreduce(MPI_IN_PLACE, p, n, MPI_C_DOUBLE_COMPLEX, MPI_SUM, comm_), "MPI_Allreduce");
-  }
+  void global_sum(double* p, int n) const { internal::sum_over_ranks(comm_, p, n); }
+  void global_sum(std::complex<double>* p, int n) const { internal::sum_over_ranks(comm_, p, n); }
 
  private:
   distributed_euler<Dim>* d_;

@@ -66,15 +66,11 @@ class distributed_euler_discretisation {
     return aerohopf::gmres<double>(op, pc, b, x, ko);
   }
 
-  void global_sum(double* p, int n) const {
-    internal::check_mpi(MPI_Allreduce(MPI_IN_PLACE, p, n, MPI_DOUBLE, MPI_SUM, comm_), "MPI_Allreduce");
-  }
+  void global_sum(double* p, int n) const { internal::sum_over_ranks(comm_, p, n); }
 
   /// The text of the lowest rank whose text is not empty ("" if none), with its rank, on every
   /// rank.
   std::string agree(const std::string& text) const {
-    int size = 0;
-    internal::check_mpi(MPI_Comm_size(comm_, &size), "MPI_Comm_size");
     int first = text.empty() ? INT_MAX : d_.rank();
     internal::check_mpi(MPI_Allreduce(MPI_IN_PLACE, &first, 1, MPI_INT, MPI_MIN, comm_), "MPI_Allreduce");
     if (first == INT_MAX) return {};
@@ -108,10 +104,7 @@ class distributed_euler_discretisation {
   bool vortex() const { return Dim == 2 && m_.options().vortex_far_field; }
   double circulation() const { return m_.circulation(); }
   void set_circulation(double g) { m_.set_circulation(g); }  // the same g on every rank (summed forces)
-  std::string conditions_text() const {
-    return aerohopf::internal::concat("M = ", m_.conditions().mach, ", alpha = ", m_.conditions().alpha_rad * 180.0 / M_PI,
-                                      " deg");
-  }
+  std::string conditions_text() const { return flow::conditions_text(m_); }
 
   /// The cell with the largest residual norm on any rank, named on every rank.
   std::pair<double, std::string> largest_residual(const vec<double>& r) const {

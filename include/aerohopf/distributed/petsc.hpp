@@ -285,7 +285,7 @@ petsc_solve_report petsc_solve(distributed_euler<Dim>& d, const block_sparse_mat
   // the true residual, by our own distributed product
   const vec<double> r = b - d.multiply(a, x);
   double s[2] = {r.squaredNorm(), b.squaredNorm()};
-  distributed::internal::check_mpi(MPI_Allreduce(MPI_IN_PLACE, s, 2, MPI_DOUBLE, MPI_SUM, comm), "MPI_Allreduce");
+  distributed::internal::sum_over_ranks(comm, s, 2);
   rep.relative_residual = s[1] > 0 ? std::sqrt(s[0] / s[1]) : std::sqrt(s[0]);
   return rep;
 }

@@ -126,6 +126,13 @@ inline Eigen::Index first_non_finite(const vec<double>& v) {
 }
 }  // namespace internal
 
+/// "M = .., alpha = .. deg": the free stream of m, for solver messages.
+template <int Dim>
+std::string conditions_text(const euler_model<Dim>& m) {
+  return aerohopf::internal::concat("M = ", m.conditions().mach, ", alpha = ", m.conditions().alpha_rad * 180.0 / M_PI,
+                                    " deg");
+}
+
 /// What the steady solver needs of a discretisation: the serial Euler model
 /// (euler_discretisation below) or one rank's part of a partitioned grid
 /// (distributed/mpi_steady.hpp). Vectors are the caller's part of the state (all of it in
@@ -216,10 +223,7 @@ class euler_discretisation {
   bool vortex() const { return Dim == 2 && m_.options().vortex_far_field; }
   double circulation() const { return m_.circulation(); }
   void set_circulation(double g) { m_.set_circulation(g); }
-  std::string conditions_text() const {
-    return aerohopf::internal::concat("M = ", m_.conditions().mach, ", alpha = ", m_.conditions().alpha_rad * 180.0 / M_PI,
-                                      " deg");
-  }
+  std::string conditions_text() const { return flow::conditions_text(m_); }
   std::pair<double, std::string> largest_residual(const vec<double>& r) const {
     constexpr int nv = block_size;
     Eigen::Index worst = 0;
