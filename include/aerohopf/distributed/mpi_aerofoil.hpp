@@ -59,6 +59,7 @@ class distributed_aerofoil {
     Eigen::MatrixXd flow_structure;        ///< A_fs: this rank's flow rows x 4
     Eigen::MatrixXd structure_flow;        ///< A_sf: 4 x this rank's flow values (its wall cells' columns)
     Eigen::Matrix4d structure;             ///< A_ss (the same on every rank)
+    double ubar = NAN;                     ///< the Ubar of A_ss (set_ubar moves it)
   };
 
   /// `sys` (the same on every rank) must outlive this object; `part` assigns its flow grid's
@@ -176,6 +177,7 @@ class distributed_aerofoil {
     const auto rs = sys_.structure().rate<sjet>(wsj, cl, cm, sjet(ubar));
     for (int i = 0; i < ns; ++i)
       for (int k = 0; k < ns; ++k) j.structure(i, k) = rs[i].derivative(k);
+    j.ubar = ubar;
 
     // A_sf: this rank's wall cells
     j.structure_flow.setZero(ns, flow_size());
@@ -195,6 +197,34 @@ class distributed_aerofoil {
     preconditioning.flow_structure = exact.flow_structure;
     preconditioning.structure_flow = exact.structure_flow;
     preconditioning.structure = exact.structure;
+    preconditioning.ubar = exact.ubar;
+  }
+
+  /// Moves Jacobian rows to another Ubar without re-assembly: Ubar enters only the stiffness,
+  /// so only A_ss changes, by the in-vacuo part -M^{-1} (K(Ubar) - K(j.ubar)).
+  void set_ubar(jacobian_rows& j, double ubar) const {
+    require(std::isfinite(ubar) && ubar != 0 && std::isfinite(j.ubar), "distributed_aerofoil::set_ubar: Ubar ", ubar,
+            " (rows assembled at ", j.ubar, ") must be finite and non-zero");
+    if (ubar == j.ubar) return;
+    const auto& st = sys_.structure();
+    j.structure += st.in_vacuo_matrix(ubar) - st.in_vacuo_matrix(j.ubar);
+    j.ubar = ubar;
+  }
+
+  /// dA/dUbar: zero but for the structural block, -M^{-1} dK/dUbar (4 x 4, every rank).
+  Eigen::Matrix4d structure_d_ubar(double ubar) const {
+    const auto& st = sys_.structure();
+    return -st.mass_inverse() * st.stiffness_d_ubar(ubar);
+  }
+
+  /// df/dUbar in this rank's part: the structural rows -M^{-1} dK/dUbar w_s on the root, zeros
+  /// elsewhere (collective: the root's structure broadcast).
+  vec<double> residual_d_ubar(const vec<double>& local, double ubar) const {
+    const vec<double> ws = structure_of(local);
+    const Eigen::MatrixXd b = structure_d_ubar(ubar);
+    vec<double> r = vec<double>::Zero(local_size());
+    if (d_.rank() == root) r.tail(ns) = b * ws;
+    return r;
   }
 
   /// y = J x in this rank's part, real or complex vectors (collective: the flow's halo, the
@@ -293,17 +323,25 @@ class distributed_aerofoil_operator {
 /// (this rank's rows) and the Schur complement S = (A_ss - sigma I) - sum over ranks A_sf Y
 /// (4 x 4, the same LU on every rank), z = P^{-1} r is y_f = M^{-1} r_f, z_s = S^{-1} (r_s -
 /// sum A_sf y_f), z_f = y_f - Y z_s: one BILU solve and two small reductions per apply.
-class distributed_aerofoil_preconditioner {
+/// S = std::complex<double> (any shift; distributed_aerofoil_preconditioner) or double (sigma
+/// = 0: the real solves with the Jacobian itself, e.g. the flow update of the full Hopf system).
+template <class S>
+class basic_distributed_aerofoil_preconditioner {
  public:
-  using C = std::complex<double>;
-  explicit distributed_aerofoil_preconditioner(block_ilu_options o = {}) : ilu_(std::move(o)) {}
+  using C = S;
+  explicit basic_distributed_aerofoil_preconditioner(block_ilu_options o = {}) : ilu_(std::move(o)) {}
 
   /// Collective; singular_matrix_error (every rank) if a BILU pivot or the Schur complement is
   /// singular.
   void compute(distributed_aerofoil& d, const distributed_aerofoil::jacobian_rows& p, C sigma) {
     d_ = &d;
     internal::collective(d.communicator(), "distributed_aerofoil_preconditioner", [&] {
-      ilu_.compute(shifted(owned_part(p.flow), sigma));
+      if constexpr (std::is_same_v<S, double>) {
+        require(sigma == 0.0, "distributed_aerofoil_preconditioner: a real preconditioner has shift 0 (got ", sigma, ")");
+        ilu_.compute(owned_part(p.flow));
+      } else {
+        ilu_.compute(shifted(owned_part(p.flow), sigma));
+      }
       y_.resize(d.flow_size(), distributed_aerofoil::ns);
       vec<C> col(d.flow_size()), out(d.flow_size());
       for (int k = 0; k < distributed_aerofoil::ns; ++k) {
@@ -313,9 +351,9 @@ class distributed_aerofoil_preconditioner {
       }
       sf_ = p.structure_flow.cast<C>();
     });
-    Eigen::MatrixXcd t = sf_ * y_;
+    mat t = sf_ * y_;
     d.sum(t.data(), 16);
-    Eigen::Matrix4cd schur = p.structure.cast<C>();
+    Eigen::Matrix<C, 4, 4> schur = p.structure.cast<C>();
     schur -= t;
     schur.diagonal().array() -= sigma;
     lu_.compute(schur);
@@ -333,7 +371,7 @@ class distributed_aerofoil_preconditioner {
     vec<C> t = sf_ * yf;
     d_->sum(t.data(), distributed_aerofoil::ns);
     const vec<C> rs = d_->structure_of(r);
-    const Eigen::Vector4cd rhs = rs - t;
+    const vec<C> rhs = rs - t;
     const vec<C> zs = lu_.solve(rhs);
     z.head(nf) = yf - y_ * zs;
     if (d_->rank() == distributed_aerofoil::root) z.tail(distributed_aerofoil::ns) = zs;
@@ -343,9 +381,12 @@ class distributed_aerofoil_preconditioner {
  private:
   distributed_aerofoil* d_ = nullptr;
   block_ilu<C, distributed_aerofoil::nv> ilu_;
-  Eigen::MatrixXcd y_, sf_;
-  Eigen::PartialPivLU<Eigen::Matrix4cd> lu_;
+  using mat = Eigen::Matrix<C, Eigen::Dynamic, Eigen::Dynamic>;
+  mat y_, sf_;
+  Eigen::PartialPivLU<Eigen::Matrix<C, 4, 4>> lu_;
 };
+
+using distributed_aerofoil_preconditioner = basic_distributed_aerofoil_preconditioner<std::complex<double>>;
 
 /// The eigenpair of the aeroelastic Jacobian J (rows `a`) nearest `shift` on the ranks: the one
 /// inverse-power iteration (bifurcation/inverse_power.hpp) with sums over the ranks, each solve

@@ -1,0 +1,516 @@
+#pragma once
+// The Hopf (flutter) point of the pitch-plunge aerofoil on MPI ranks (distributed_aerofoil), in
+// both formulations of bifurcation/hopf.hpp:
+//  * fixed equilibrium: unknowns [p_r, p_i, Ubar, omega], w given (the section at rest at zero
+//    incidence, the equilibrium independent of Ubar);
+//  * full: unknowns [w, p_r, p_i, Ubar, omega], the equilibrium moving with Ubar (a mean
+//    incidence: the static pitch deflection depends on Ubar).
+// F_A as in hopf.hpp, with the normalisation s = e_k, k the largest component of the start's p
+// over all ranks (p_k = i), so F_A's border rows are sparse on the ranks too.
+//
+// Vectors: each rank holds its part of w, p_r and p_i (distributed_aerofoil's local order: its
+// flow values, then the structure, significant on the root); Ubar and omega are held by every
+// rank, and in the Newton correction, as the structure, on the root only, so that a sum over
+// the ranks of local inner products counts every unknown once.
+//
+// Newton step: the bordered elimination of hopf_bordered.hpp (bordered_hopf_step), every solve
+// by GMRES on the ranks.
+//  * The eigen-equations and the border: GMRES on the exact real (2n + 2) bordered matrix, its
+//    inner operator the complex product with J - i omega I (the Jacobian rows assembled on the
+//    ranks, distributed_aerofoil::multiply), right-preconditioned by the complex block-Jacobi
+//    BILU(k) of L - i omega I (L the modified-order rows, the structural border eliminated exactly:
+//    distributed_aerofoil_preconditioner) with the two Hopf border unknowns eliminated around it.
+//  * The full formulation's flow update: dw0 = -A^{-1} f, dw1 = -A^{-1} f_Ubar by real GMRES on
+//    A preconditioned by the real BILU(k) of L; the second-derivative products (A_w p) dw by
+//    central differences of the Jacobian rows re-assembled at w +- h dw (O(h^2): the rate of
+//    Newton's convergence only).
+// F_A is evaluated with the exact Jacobian rows at the iterate. Ubar enters only the structural
+// stiffness, so in the fixed-equilibrium formulation the rows are assembled once and moved to
+// each iterate's Ubar exactly (distributed_aerofoil::set_ubar): the operator of every GMRES
+// solve is the exact Jacobian and the convergence is quadratic with inexact solves. The
+// preconditioner is computed at the start and again after a step that reduced ||F|| less than
+// tenfold; in the full formulation everything is re-assembled at every iterate (A moves with w).
+//
+// Stopping and checks (as hopf.hpp, sums over the ranks): ||F_A|| <= abs_tolerance +
+// rel_tolerance ||F_A(start)|| (hopf_options::newton; its rounding-floor test is not used);
+// failure (convergence_error on every rank, naming the iterate, ||F||, Ubar and omega) on a
+// non-finite or diverging residual (> divergence_factor ||F_0||), a GMRES failure, or the
+// iteration limit; with newton.throw_on_failure = false the result holds the last iterate
+// instead, report.converged = false. A converged point is accepted if the equilibrium holds at
+// Ubar* (fixed formulation: ||f(w, Ubar*)|| <= max(equilibrium_tolerance, equilibrium_factor
+// ||F||)) and omega is resolved (|omega| > 10 ||F|| / ||p||); omega > 0 on return.
+
+#include <mpi.h>
+
+#include <aerohopf/bifurcation/hopf.hpp>
+#include <aerohopf/distributed/mpi_aerofoil.hpp>
+#include <aerohopf/linalg/krylov.hpp>
+
+#include <Eigen/LU>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <complex>
+#include <iomanip>
+#include <limits>
+#include <string>
+#include <vector>
+
+namespace aerohopf::distributed {
+
+struct distributed_hopf_options {
+  /// Newton tolerances and limits, formulation (fixed_equilibrium), acceptance, progress and
+  /// label, as for the serial solvers (normalisation and approximate_lhs do not apply).
+  hopf_options hopf;
+  int fill_level = 0;  ///< k of the block-Jacobi BILU(k)
+  /// GMRES of each correction: relative tolerance eta_k = min(eta_max, max(||F_k||, 0.1
+  /// abs_tolerance / ||F_k||)) (inexact Newton, quadratic), restart and iteration limit.
+  krylov_options krylov = [] {
+    krylov_options o;
+    o.max_iterations = 2000;
+    o.restart = 80;
+    o.record_history = false;
+    return o;
+  }();
+  double eta_max = 1e-2;
+};
+
+/// A Hopf point's guess or result on the ranks: this rank's parts of w and p.
+struct distributed_hopf_point {
+  vec<double> w;                   ///< this rank's part of the equilibrium
+  double mu = NAN, omega = NAN;    ///< Ubar and omega (every rank)
+  vec<std::complex<double>> p;     ///< this rank's part of the eigenvector
+};
+
+struct distributed_hopf_result {
+  distributed_hopf_point point;  ///< p with p_k = i at the normalisation's component k
+  newton_report report;
+  long linear_iterations = 0;    ///< GMRES iterations over all solves
+  double setup_seconds = 0, linear_seconds = 0, residual_seconds = 0;
+};
+
+namespace internal {
+
+using hopf_clock = std::chrono::steady_clock;
+inline double since(hopf_clock::time_point t0) {
+  return std::chrono::duration<double>(hopf_clock::now() - t0).count();
+}
+
+/// The real (2n + 2) bordered matrix of the eigen-equations in the real split form on the ranks:
+/// v = [x_r, x_i, a, b] (each rank its parts of x_r and x_i; a, b on the root) ->
+///   [(J x)_r + omega x_i + a m_r + b p_i;  (J x)_i - omega x_r + a m_i - b p_r;  s.x_r;  s.x_i]
+/// with m = the Ubar column and s the normalisation (sums over the ranks, rows on the root).
+class hopf_bordered_operator {
+ public:
+  using C = std::complex<double>;
+  hopf_bordered_operator(distributed_aerofoil& d, const distributed_aerofoil::jacobian_rows& j, double omega,
+                         vec<double> mu_column, const vec<double>& pr, const vec<double>& pi, const vec<double>& s)
+      : d_(&d), j_(&j), omega_(omega), n_(d.local_size()), mu_col_(std::move(mu_column)), om_col_(2 * n_), s_(&s) {
+    om_col_ << pi, -pr;
+  }
+  Eigen::Index rows() const { return 2 * n_ + 2; }
+  Eigen::Index cols() const { return 2 * n_ + 2; }
+  const vec<double>& mu_column() const { return mu_col_; }
+  const vec<double>& omega_column() const { return om_col_; }
+  const vec<double>& s() const { return *s_; }
+  void apply(const vec<double>& v, vec<double>& y) const {
+    std::array<double, 2> ab{v[2 * n_], v[2 * n_ + 1]};  // the root's, summed: the others hold zeros
+    d_->sum(ab.data(), 2);
+    vec<C> x(n_);
+    x.real() = v.head(n_);
+    x.imag() = v.segment(n_, n_);
+    const vec<C> jx = d_->multiply(*j_, x);
+    y.resize(rows());
+    y.head(n_) = jx.real() + omega_ * v.segment(n_, n_);
+    y.segment(n_, n_) = jx.imag() - omega_ * v.head(n_);
+    y.head(2 * n_) += ab[0] * mu_col_ + ab[1] * om_col_;
+    std::array<double, 2> sx{s_->dot(v.head(n_)), s_->dot(v.segment(n_, n_))};
+    d_->sum(sx.data(), 2);
+    y[2 * n_] = d_->rank() == distributed_aerofoil::root ? sx[0] : 0.0;
+    y[2 * n_ + 1] = d_->rank() == distributed_aerofoil::root ? sx[1] : 0.0;
+  }
+  void global_sum(double* p, int n) const { d_->sum(p, n); }
+
+ private:
+  distributed_aerofoil* d_;
+  const distributed_aerofoil::jacobian_rows* j_;
+  double omega_;
+  Eigen::Index n_;
+  vec<double> mu_col_, om_col_;
+  const vec<double>* s_;
+};
+
+/// Its preconditioner: the complex preconditioner M of L - i omega I in the split form, the two
+/// border unknowns eliminated around it (W = M^{-1} [m, omega column], 2 x 2 Schur complement
+/// -s^T W summed over the ranks): one application of M and one reduction of four values.
+class hopf_bordered_preconditioner {
+ public:
+  using C = std::complex<double>;
+  hopf_bordered_preconditioner(const distributed_aerofoil_preconditioner& m, distributed_aerofoil& d,
+                               const hopf_bordered_operator& op)
+      : m_(&m), d_(&d), n_(d.local_size()), s_(&op.s()), w_(2 * n_, 2) {
+    vec<double> z(2 * n_);
+    split_apply(op.mu_column(), z);
+    w_.col(0) = z;
+    split_apply(op.omega_column(), z);
+    w_.col(1) = z;
+    std::array<double, 4> vw{};
+    for (int c = 0; c < 2; ++c) {
+      vw[c] = s_->dot(w_.col(c).head(n_));
+      vw[2 + c] = s_->dot(w_.col(c).segment(n_, n_));
+    }
+    d.sum(vw.data(), 4);
+    Eigen::Matrix2d schur;
+    schur << -vw[0], -vw[1], -vw[2], -vw[3];
+    if (!schur.allFinite() || !(std::abs(schur.determinant()) > 0))
+      throw singular_matrix_error(aerohopf::internal::concat(
+          "distributed Hopf preconditioner: the 2 x 2 Schur complement of the border is singular or not finite (det ",
+          schur.determinant(), "): Ubar and omega not determined"));
+    schur_inv_ = schur.inverse();
+  }
+  Eigen::Index rows() const { return 2 * n_ + 2; }
+  void apply(const vec<double>& r, vec<double>& z) const {
+    vec<double> z1(2 * n_);
+    split_apply(r.head(2 * n_), z1);
+    const bool root = d_->rank() == distributed_aerofoil::root;  // the border rows: the root's
+    std::array<double, 2> t{(root ? r[2 * n_] : 0.0) - s_->dot(z1.head(n_)),
+                            (root ? r[2 * n_ + 1] : 0.0) - s_->dot(z1.segment(n_, n_))};
+    d_->sum(t.data(), 2);
+    const Eigen::Vector2d sol = schur_inv_ * Eigen::Vector2d(t[0], t[1]);
+    z.resize(rows());
+    z.head(2 * n_) = z1 - w_ * vec<double>(sol);
+    z[2 * n_] = d_->rank() == distributed_aerofoil::root ? sol[0] : 0.0;
+    z[2 * n_ + 1] = d_->rank() == distributed_aerofoil::root ? sol[1] : 0.0;
+  }
+
+ private:
+  template <class V>
+  void split_apply(const V& r, vec<double>& z) const {
+    vec<C> rc(n_), zc(n_);
+    rc.real() = r.head(n_);
+    rc.imag() = r.segment(n_, n_);
+    m_->apply(rc, zc);
+    z.head(n_) = zc.real();
+    z.segment(n_, n_) = zc.imag();
+  }
+  const distributed_aerofoil_preconditioner* m_;
+  distributed_aerofoil* d_;
+  Eigen::Index n_;
+  const vec<double>* s_;
+  Eigen::MatrixXd w_;
+  Eigen::Matrix2d schur_inv_;
+};
+
+/// A on real vectors of the ranks (the flow update's operator).
+class real_aerofoil_operator {
+ public:
+  real_aerofoil_operator(distributed_aerofoil& d, const distributed_aerofoil::jacobian_rows& j) : d_(&d), j_(&j) {}
+  Eigen::Index rows() const { return d_->local_size(); }
+  Eigen::Index cols() const { return d_->local_size(); }
+  void apply(const vec<double>& x, vec<double>& y) const { y = d_->multiply(*j_, x); }
+  void global_sum(double* p, int n) const { d_->sum(p, n); }
+
+ private:
+  distributed_aerofoil* d_;
+  const distributed_aerofoil::jacobian_rows* j_;
+};
+
+inline double sum_squares(const distributed_aerofoil& d, double local) {
+  d.sum(&local, 1);
+  return local;
+}
+/// Whether `ok` holds on every rank (collective).
+inline bool on_every_rank(MPI_Comm comm, bool ok) {
+  int v = ok ? 1 : 0;
+  check_mpi(MPI_Allreduce(MPI_IN_PLACE, &v, 1, MPI_INT, MPI_MIN, comm), "MPI_Allreduce");
+  return v == 1;
+}
+inline double global_max(MPI_Comm comm, double v) {
+  check_mpi(MPI_Allreduce(MPI_IN_PLACE, &v, 1, MPI_DOUBLE, MPI_MAX, comm), "MPI_Allreduce");
+  return v;
+}
+
+}  // namespace internal
+
+/// Newton on the Hopf system of a distributed_aerofoil from `guess` (file comment), the
+/// formulation from opt.hopf.fixed_equilibrium. Collective: every rank passes its parts and gets
+/// the same Ubar*, omega* and its part of w* and p*. input_error (every rank) for a guess of the
+/// wrong sizes, not finite, a zero eigenvector or bad options; convergence_error or
+/// singular_matrix_error (every rank) for a failure, as the file comment says.
+inline distributed_hopf_result solve_hopf(distributed_aerofoil& d, const distributed_hopf_point& guess,
+                                          const distributed_hopf_options& opt = {}) {
+  using C = std::complex<double>;
+  const hopf_options& ho = opt.hopf;
+  const bool fixed = ho.fixed_equilibrium;
+  const std::string who = fixed ? "distributed solve_hopf" : "distributed solve_hopf (full system)";
+  const std::string label = ho.label;
+  const MPI_Comm comm = d.communicator();
+  const Eigen::Index n = d.local_size();
+  const bool root = d.rank() == distributed_aerofoil::root;
+  internal::collective(comm, who.c_str(), [&] {
+    aerohopf::internal::check_hopf_options(ho, who);
+    validate_krylov_options(opt.krylov, who);
+    require(opt.fill_level >= 0 && opt.fill_level <= 8, who, ": fill_level must lie in [0, 8] (got ", opt.fill_level,
+            ")");
+    require(opt.eta_max > 0 && opt.eta_max < 1, who, ": eta_max must lie in (0, 1) (got ", opt.eta_max, ")");
+    require_size(guess.w.size(), n, who, "guess.w (this rank's flow values and 4 structural)");
+    require_size(guess.p.size(), n, who, "guess.p (this rank's part of the eigenvector)");
+    require_finite(guess.w, who, "guess.w");
+    require_finite(guess.p, who, "guess.p");
+    require(std::isfinite(guess.mu) && guess.mu != 0, who, ": guess.mu (Ubar) ", guess.mu, " must be finite and non-zero");
+    require(std::isfinite(guess.omega), who, ": guess.omega ", guess.omega, " is not finite");
+  });
+  {
+    double agree[2] = {guess.mu, guess.omega}, mx[2], mn[2];
+    internal::check_mpi(MPI_Allreduce(agree, mx, 2, MPI_DOUBLE, MPI_MAX, comm), "MPI_Allreduce");
+    internal::check_mpi(MPI_Allreduce(agree, mn, 2, MPI_DOUBLE, MPI_MIN, comm), "MPI_Allreduce");
+    if (mx[0] != mn[0] || mx[1] != mn[1])
+      throw input_error(aerohopf::internal::concat(who, ": guess.mu and guess.omega differ between the ranks"));
+  }
+
+  // normalisation: s = e_k at the largest |p_k| over the ranks, p scaled to p_k = i
+  vec<C> p = guess.p;
+  vec<double> s = vec<double>::Zero(n);
+  {
+    struct {
+      double value;
+      int rank;
+    } best{-1.0, d.rank()};
+    Eigen::Index k = 0;
+    if (n > 0) best.value = p.cwiseAbs().maxCoeff(&k);
+    internal::check_mpi(MPI_Allreduce(MPI_IN_PLACE, &best, 1, MPI_DOUBLE_INT, MPI_MAXLOC, comm), "MPI_Allreduce");
+    if (!(best.value > 0)) throw input_error(who + ": guess.p (eigenvector) is zero");
+    C pk = d.rank() == best.rank ? p[k] : C(0.0);
+    internal::check_mpi(MPI_Bcast(&pk, 1, MPI_C_DOUBLE_COMPLEX, best.rank, comm), "MPI_Bcast");
+    p *= C(0.0, 1.0) / pk;
+    if (d.rank() == best.rank) {
+      s[k] = 1.0;
+      p[k] = C(0.0, 1.0);
+    }
+  }
+
+  // the iterate
+  vec<double> w = guess.w, pr = p.real(), pi = p.imag();
+  double mu = guess.mu, om = guess.omega;
+  distributed_hopf_result res;
+  distributed_aerofoil::jacobian_rows a, l, ap, am;
+  block_ilu_options io;
+  io.fill_level = opt.fill_level;
+  io.context = aerohopf::internal::concat(label, ": block-Jacobi BILU(", opt.fill_level, ") of L - i omega I");
+  distributed_aerofoil_preconditioner pc(io);
+  block_ilu_options ior = io;
+  ior.context = aerohopf::internal::concat(label, ": block-Jacobi BILU(", opt.fill_level, ") of L (flow update)");
+  basic_distributed_aerofoil_preconditioner<double> pc_real(ior);
+  bool preconditioned = false;
+
+  // F_A at the iterate (local parts; border rows on the root) with the Jacobian rows a at (w, mu)
+  auto residual = [&]() {
+    const auto t0 = internal::hopf_clock::now();
+    const Eigen::Index off = fixed ? 0 : n;
+    vec<double> f = vec<double>::Zero(off + 2 * n + 2);
+    if (!fixed) f.head(n) = d.residual(w, mu);
+    vec<C> pc_(n);
+    pc_.real() = pr;
+    pc_.imag() = pi;
+    const vec<C> ap_ = d.multiply(a, pc_);
+    f.segment(off, n) = ap_.real() + om * pi;
+    f.segment(off + n, n) = ap_.imag() - om * pr;
+    std::array<double, 2> sp{s.dot(pr), s.dot(pi)};
+    d.sum(sp.data(), 2);
+    if (root) {
+      f[off + 2 * n] = sp[0];
+      f[off + 2 * n + 1] = sp[1] - 1.0;
+    }
+    res.residual_seconds += internal::since(t0);
+    return f;
+  };
+  auto norm = [&](const vec<double>& f) {
+    const double q = internal::sum_squares(d, f.allFinite() ? f.squaredNorm() : NAN);
+    return std::sqrt(q);
+  };
+  auto assemble = [&]() {
+    const auto t0 = internal::hopf_clock::now();
+    d.jacobians(w, mu, a, l);
+    res.setup_seconds += internal::since(t0);
+  };
+  auto precondition = [&]() {
+    const auto t0 = internal::hopf_clock::now();
+    d.set_ubar(l, mu);
+    pc.compute(d, l, C(0.0, om));
+    if (!fixed) pc_real.compute(d, l, 0.0);
+    preconditioned = true;
+    res.setup_seconds += internal::since(t0);
+  };
+
+  const newton_options& no = ho.newton;
+  auto& rep = res.report;
+  const auto t_start = internal::hopf_clock::now();
+  auto where = [&](int k, double fk) {
+    return aerohopf::internal::concat(" [iterate ", k, ": ||F|| = ", fk, ", Ubar = ", mu, ", omega = ", om, "]");
+  };
+  auto fail = [&](const std::string& why, int k, double fk) {
+    rep.converged = false;
+    rep.reason = label + ": " + why + where(k, fk);
+    rep.failed_iteration = k + 1;
+    if (no.throw_on_failure) throw convergence_error(rep.reason);
+  };
+  assemble();
+  vec<double> f = residual();
+  double fn = norm(f);
+  const double f0 = fn, target = no.abs_tolerance + no.rel_tolerance * f0;
+  rep.residual_history.push_back(fn);
+  double last = fn;
+  if (ho.verbose && ho.log && root)
+    *ho.log << label << " it  0  |F| " << std::scientific << std::setprecision(3) << fn << std::defaultfloat
+            << "  Ubar " << std::setprecision(12) << mu << "  omega " << om << "\n";
+  for (int k = 0;; ++k) {
+    if (!std::isfinite(fn)) {
+      fail("the Hopf residual is not finite", k, fn);
+      break;
+    }
+    if (fn <= target) {
+      rep.converged = true;
+      break;
+    }
+    if (fn > no.divergence_factor * f0) {
+      fail(aerohopf::internal::concat("diverged (||F|| > ", no.divergence_factor, " ||F_0||)"), k, fn);
+      break;
+    }
+    if (k >= no.max_iterations) {
+      fail(aerohopf::internal::concat("no convergence in ", no.max_iterations, " Newton iterations"), k, fn);
+      break;
+    }
+    // Newton step k + 1
+    try {
+      if (!fixed) assemble();  // (already current for k = 0)
+      if (!preconditioned || !fixed || (k > 0 && fn > 0.1 * last)) precondition();
+      krylov_options ko = opt.krylov;
+      ko.relative_tolerance = std::min(opt.eta_max, std::max(fn, 0.1 * no.abs_tolerance / fn));
+      ko.throw_on_failure = true;
+      vec<double> mu_col(2 * n);
+      {
+        const Eigen::MatrixXd b = d.structure_d_ubar(mu);
+        mu_col.setZero();
+        const vec<double> psr = d.structure_of(pr), psi = d.structure_of(pi);
+        if (root) {
+          constexpr int ns = distributed_aerofoil::ns;
+          mu_col.segment(n - ns, ns) = b * psr;
+          mu_col.segment(2 * n - ns, ns) = b * psi;
+        }
+      }
+      vec<double> rhs = -f.tail(2 * n + 2);
+      vec<double> dw0, dw1;
+      if (!fixed) {
+        const internal::real_aerofoil_operator aop(d, a);
+        const auto t0 = internal::hopf_clock::now();
+        dw0 = vec<double>::Zero(n);
+        dw1 = vec<double>::Zero(n);
+        ko.context = aerohopf::internal::concat(label, ": GMRES on A (flow update dw0) at Newton iteration ", k + 1);
+        res.linear_iterations += gmres<double>(aop, pc_real, vec<double>(-f.head(n)), dw0, ko).iterations;
+        ko.context = aerohopf::internal::concat(label, ": GMRES on A (flow update dw1) at Newton iteration ", k + 1);
+        res.linear_iterations +=
+            gmres<double>(aop, pc_real, vec<double>(-d.residual_d_ubar(w, mu)), dw1, ko).iterations;
+        res.linear_seconds += internal::since(t0);
+        // (A_w p) dw by central differences of the Jacobian rows at w +- h dw
+        const auto t1 = internal::hopf_clock::now();
+        const double w_inf = internal::global_max(comm, w.cwiseAbs().maxCoeff());
+        for (int which = 0; which < 2; ++which) {
+          const vec<double>& x = which == 0 ? dw0 : dw1;
+          const double x_inf = internal::global_max(comm, x.size() ? x.cwiseAbs().maxCoeff() : 0.0);
+          if (!(x_inf > 0)) continue;
+          const double h = std::cbrt(std::numeric_limits<double>::epsilon()) * std::max(1.0, w_inf) / x_inf;
+          d.jacobian(vec<double>(w + h * x), mu, flow::jacobian_kind::exact, ap);
+          d.jacobian(vec<double>(w - h * x), mu, flow::jacobian_kind::exact, am);
+          vec<C> pcx(n);
+          pcx.real() = pr;
+          pcx.imag() = pi;
+          const vec<C> bp = (d.multiply(ap, pcx) - d.multiply(am, pcx)) / (2 * h);
+          if (!internal::on_every_rank(comm, bp.allFinite()))
+            throw convergence_error(aerohopf::internal::concat("a second-derivative product is not finite at Newton iteration ", k + 1));
+          if (which == 0) {
+            rhs.head(n) -= bp.real();
+            rhs.segment(n, n) -= bp.imag();
+          } else {
+            mu_col.head(n) += bp.real();
+            mu_col.tail(n) += bp.imag();
+          }
+        }
+        res.residual_seconds += internal::since(t1);
+      }
+      const auto t0 = internal::hopf_clock::now();
+      const internal::hopf_bordered_operator op(d, a, om, std::move(mu_col), pr, pi, s);
+      const internal::hopf_bordered_preconditioner bp(pc, d, op);
+      vec<double> dx = vec<double>::Zero(2 * n + 2);
+      ko.context = aerohopf::internal::concat(label, ": GMRES on the bordered eigen-equations at Newton iteration ", k + 1);
+      res.linear_iterations += gmres<double>(op, bp, rhs, dx, ko).iterations;
+      res.linear_seconds += internal::since(t0);
+      std::array<double, 2> dm{dx[2 * n], dx[2 * n + 1]};
+      d.sum(dm.data(), 2);
+      if (!internal::on_every_rank(comm, dx.allFinite()) || !std::isfinite(dm[0]) || !std::isfinite(dm[1]))
+        throw convergence_error(aerohopf::internal::concat("the Newton correction is not finite at iteration ", k + 1));
+      if (!fixed) w += dw0 + dm[0] * dw1;
+      pr += dx.head(n);
+      pi += dx.segment(n, n);
+      mu += dm[0];
+      om += dm[1];
+      if (fixed) d.set_ubar(a, mu);
+      else assemble();
+      last = fn;
+      f = residual();
+      fn = norm(f);
+      rep.iterations = k + 1;
+      rep.residual_history.push_back(fn);
+      if (ho.verbose && ho.log && root)
+        *ho.log << label << " it " << std::setw(2) << k + 1 << "  |F| " << std::scientific << std::setprecision(3) << fn
+                << std::defaultfloat << "  Ubar " << std::setprecision(12) << mu << "  omega " << om << "  linear its "
+                << res.linear_iterations << "\n";
+    } catch (const input_error&) {
+      throw;
+    } catch (const error& e) {
+      // a failed step (GMRES, a singular preconditioner, a non-finite correction) on every
+      // rank: thrown as its own type with the last accepted iterate, or the result holds it
+      rep.failed_iteration = k + 1;
+      if (no.throw_on_failure) aerohopf::internal::rethrow_with_context(label + ": ", where(k, fn));
+      rep.converged = false;
+      rep.reason = label + ": " + e.what() + where(k, fn);
+      break;
+    }
+  }
+  rep.seconds = internal::since(t_start);
+
+  // the point, omega > 0, and the post-checks
+  res.point.w = w;
+  res.point.mu = mu;
+  res.point.omega = om;
+  res.point.p.resize(n);
+  res.point.p.real() = pr;
+  res.point.p.imag() = pi;
+  if (!rep.converged) return res;
+  if (res.point.omega < 0) {
+    res.point.omega = -res.point.omega;
+    res.point.p = res.point.p.conjugate().eval();
+  }
+  const double r = std::max(target, fn);
+  const double tol_f = fixed ? std::max(ho.equilibrium_tolerance, ho.equilibrium_factor * r) : r;
+  const double f_eq = norm(d.residual(w, mu));
+  const double p_norm = std::sqrt(internal::sum_squares(d, res.point.p.squaredNorm()));
+  std::string why;
+  if (!(f_eq <= tol_f))
+    why = aerohopf::internal::concat("the equilibrium does not hold at Ubar* = ", mu, ": ||f(w, Ubar*)|| = ", f_eq,
+                                     " > tolerance ", tol_f,
+                                     fixed ? " (fixed-equilibrium formulation: an equilibrium that moves with Ubar "
+                                             "needs the full one)"
+                                           : "");
+  else if (!(std::abs(om) > aerohopf::internal::hopf_frequency_floor(r, p_norm)))
+    why = aerohopf::internal::concat("converged to omega = ", om, " at Ubar* = ", mu,
+                                     ", below the resolved frequency: a real eigenvalue (divergence), not a Hopf point");
+  if (!why.empty()) {
+    rep.converged = false;
+    rep.reason = label + ": " + why;
+    if (no.throw_on_failure) throw convergence_error(rep.reason);
+  }
+  return res;
+}
+
+}  // namespace aerohopf::distributed

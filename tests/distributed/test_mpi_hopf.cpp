@@ -1,0 +1,204 @@
+// The Hopf (flutter) point of the pitch-plunge NACA 0012 on MPI ranks (distributed/mpi_hopf.hpp),
+// run by CTest under mpirun on 2 and 3 ranks, against the serial Krylov Hopf solver
+// (solve_hopf_krylov) on the same very coarse grid (light case, M = 0.5):
+//  * fixed equilibrium (zero incidence): from the serial start's parts, and from a start found on
+//    the ranks (inverse power of the distributed Jacobian at Ubar = 1.75, shift 0.6i), Ubar* and
+//    omega* equal the serial ones to 1e-9 relative and p* is the serial eigenvector (up to the
+//    complex scale of the normalisation); the convergence is quadratic;
+//  * full formulation (mean incidence 1 deg: the static pitch deflection moves with Ubar): from
+//    the static equilibrium at Ubar = 1.7, Ubar*, omega* and the moving equilibrium w* equal the
+//    serial full Krylov solve's; the fixed-equilibrium formulation refuses that equilibrium;
+//  * bad input is refused on every rank and a Newton limit reached is a convergence_error on
+//    every rank, or a result not converged holding the last iterate.
+#include <gtest/gtest.h>
+#include <mpi.h>
+
+#include <aerohopf/bifurcation/hopf_bordered.hpp>
+#include <aerohopf/distributed/mpi_hopf.hpp>
+#include <aerohopf/models/aerofoil_family.hpp>
+
+#include <complex>
+#include <iostream>
+#include <numbers>
+#include <string>
+
+#include "support/error_messages.hpp"
+#include "support/mpi_test.hpp"
+#include "support/partition_grids.hpp"
+
+using namespace aerohopf;
+using namespace aerohopf::distributed;
+using aerohopf::test::world_size;
+using cd = std::complex<double>;
+
+namespace {
+
+models::aerofoil_family family(double alpha_deg) {
+  structure::pitch_plunge_parameters p;
+  p.mu_s = 10;
+  return models::aerofoil_family(flow::naca_cgrid(), p, {}, alpha_deg * std::numbers::pi / 180);
+}
+
+/// This rank's part of a complex vector.
+vec<cd> local_part(distributed_aerofoil& d, const vec<cd>& g) {
+  const vec<double> re = d.local_part(vec<double>(g.real())), im = d.local_part(vec<double>(g.imag()));
+  vec<cd> x(re.size());
+  x.real() = re;
+  x.imag() = im;
+  return x;
+}
+vec<cd> gather(distributed_aerofoil& d, const vec<cd>& local) {
+  const vec<double> re = d.all_gather(vec<double>(local.real())), im = d.all_gather(vec<double>(local.imag()));
+  vec<cd> x(re.size());
+  x.real() = re;
+  x.imag() = im;
+  return x;
+}
+/// ||p - c q|| / ||p|| with c the best complex scale: the same eigenvector up to normalisation.
+double eigenvector_distance(const vec<cd>& p, const vec<cd>& q) {
+  const cd c = q.dot(p) / q.squaredNorm();
+  return (p - c * q).norm() / p.norm();
+}
+
+distributed_hopf_point local_guess(distributed_aerofoil& d, const hopf_point& g) {
+  return {d.local_part(g.w), g.mu, g.omega, local_part(d, g.p)};
+}
+
+void expect_quadratic(const newton_report& r) {
+  const auto& h = r.residual_history;
+  ASSERT_GE(h.size(), 3u);
+  // the last step squares (or beats) the error of the one before, up to a constant
+  EXPECT_LT(h.back(), 10 * h[h.size() - 2] * h[h.size() - 2] + 1e-11) << "not quadratic";
+}
+
+}  // namespace
+
+TEST(mpi_hopf, fixed_equilibrium_equals_the_serial_krylov_solve) {
+  const auto f = family(0.0);
+  const models::aerofoil_system sys = f.system(8, 0.5);
+  const vec<double> w = sys.steady_equilibrium();
+  const hopf_point start = hopf_start(sys, w, 1.75, 0.6);
+  hopf_options opt;
+  opt.fixed_equilibrium = true;
+  const hopf_result ref = solve_hopf_krylov<4>(sys, start, opt);
+  ASSERT_TRUE(ref.report.converged);
+
+  distributed_aerofoil d(sys, partition_blocks(sys.flow(), world_size()), MPI_COMM_WORLD);
+  distributed_hopf_options o;
+  o.hopf = opt;
+  o.hopf.label = "distributed hopf";
+  o.hopf.verbose = true;
+  const distributed_hopf_result r = distributed::solve_hopf(d, local_guess(d, start), o);
+  ASSERT_TRUE(r.report.converged) << r.report.reason;
+  EXPECT_LT(std::abs(r.point.mu - ref.point.mu), 1e-9 * ref.point.mu) << r.point.mu << " vs " << ref.point.mu;
+  EXPECT_LT(std::abs(r.point.omega - ref.point.omega), 1e-9 * ref.point.omega);
+  EXPECT_GT(r.point.omega, 0.0);
+  EXPECT_LT(eigenvector_distance(gather(d, r.point.p), ref.point.p), 1e-8);
+  EXPECT_EQ(d.all_gather(r.point.w), w);  // the equilibrium is not an unknown
+  EXPECT_GT(r.linear_iterations, 0);
+  expect_quadratic(r.report);
+  if (d.rank() == 0)
+    std::cout << world_size() << " ranks: Ubar* " << std::setprecision(15) << r.point.mu << " omega* " << r.point.omega
+              << " (serial " << ref.point.mu << ", " << ref.point.omega << "), " << r.report.iterations << " Newton / "
+              << r.linear_iterations << " GMRES iterations (serial " << ref.report.iterations << " / "
+              << ref.linear_iterations << ")\n";
+
+  // the whole pipeline on the ranks: the start by inverse power of the distributed Jacobian
+  distributed_aerofoil::jacobian_rows a, p;
+  const vec<double> wl = d.local_part(w);
+  d.jacobians(wl, 1.75, a, p);
+  distributed_inverse_power_options io;
+  io.power.tolerance = 1e-8;  // a start: Newton converges the pair
+  const eigen_pair ep = distributed::inverse_power(d, a, &p, cd(0.0, 0.6), io);
+  distributed_hopf_point g{wl, 1.75, std::abs(ep.lambda.imag()), ep.vector};
+  if (ep.lambda.imag() < 0) g.p = g.p.conjugate().eval();
+  o.hopf.verbose = false;
+  const distributed_hopf_result r2 = distributed::solve_hopf(d, g, o);
+  ASSERT_TRUE(r2.report.converged) << r2.report.reason;
+  EXPECT_LT(std::abs(r2.point.mu - ref.point.mu), 1e-9 * ref.point.mu);
+  EXPECT_LT(std::abs(r2.point.omega - ref.point.omega), 1e-9 * ref.point.omega);
+}
+
+TEST(mpi_hopf, full_formulation_equals_the_serial_full_krylov_solve) {
+  const auto f = family(1.0);
+  const models::aerofoil_system sys = f.system(8, 0.5);
+  const vec<double> w17 = f.static_equilibrium(sys, 1.7, 2, 1e-10);
+  const hopf_point start = hopf_start(sys, w17, 1.7, 0.6);
+  hopf_options opt;
+  opt.fixed_equilibrium = false;
+  hopf_krylov_options ko;
+  ko.full_system = true;
+  const hopf_result ref = solve_hopf_krylov<4>(sys, start, opt, ko);
+  ASSERT_TRUE(ref.report.converged);
+
+  distributed_aerofoil d(sys, partition_blocks(sys.flow(), world_size()), MPI_COMM_WORLD);
+  distributed_hopf_options o;
+  o.hopf = opt;
+  o.hopf.label = "distributed hopf (full)";
+  o.hopf.verbose = true;
+  const distributed_hopf_result r = distributed::solve_hopf(d, local_guess(d, start), o);
+  ASSERT_TRUE(r.report.converged) << r.report.reason;
+  EXPECT_LT(std::abs(r.point.mu - ref.point.mu), 1e-9 * ref.point.mu) << r.point.mu << " vs " << ref.point.mu;
+  EXPECT_LT(std::abs(r.point.omega - ref.point.omega), 1e-9 * ref.point.omega);
+  const vec<double> wg = d.all_gather(r.point.w);
+  EXPECT_LT((wg - ref.point.w).norm(), 1e-8 * ref.point.w.norm());
+  EXPECT_GT(wg[wg.size() - 2], w17[w17.size() - 2]);  // the static pitch deflection moved with Ubar
+  EXPECT_LT(eigenvector_distance(gather(d, r.point.p), ref.point.p), 1e-7);
+  if (d.rank() == 0)
+    std::cout << world_size() << " ranks (full): Ubar* " << std::setprecision(15) << r.point.mu << " omega* "
+              << r.point.omega << " pitch " << wg[wg.size() - 2] << " (serial " << ref.point.mu << ", "
+              << ref.point.omega << "), " << r.report.iterations << " Newton / " << r.linear_iterations
+              << " GMRES iterations (serial " << ref.report.iterations << " / " << ref.linear_iterations << ")\n";
+
+  // the fixed-equilibrium formulation refuses an equilibrium that moves with Ubar, on every rank
+  distributed_hopf_options fo = o;
+  fo.hopf.fixed_equilibrium = true;
+  fo.hopf.verbose = false;
+  const std::string msg = test::error_of<convergence_error>([&] { (void)distributed::solve_hopf(d, local_guess(d, start), fo); });
+  EXPECT_TRUE(test::contains(msg, "equilibrium does not hold")) << msg;
+}
+
+TEST(mpi_hopf, bad_input_and_failures_are_the_same_on_every_rank) {
+  const auto f = family(0.0);
+  const models::aerofoil_system sys = f.system(8, 0.5);
+  const vec<double> w = sys.steady_equilibrium();
+  const hopf_point start = hopf_start(sys, w, 1.75, 0.6);
+  distributed_aerofoil d(sys, partition_blocks(sys.flow(), world_size()), MPI_COMM_WORLD);
+  distributed_hopf_options o;
+  o.hopf.fixed_equilibrium = true;
+  const distributed_hopf_point g = local_guess(d, start);
+  const int last = world_size() - 1;
+  // a short eigenvector part on the last rank only
+  distributed_hopf_point bad = g;
+  if (d.rank() == last) bad.p = bad.p.head(bad.p.size() - 1).eval();
+  std::string msg = test::input_error_of([&] { (void)distributed::solve_hopf(d, bad, o); });
+  EXPECT_TRUE(test::contains(msg, d.rank() == last ? "guess.p" : "refused on rank")) << msg;
+  // NaN in w on rank 0, a zero eigenvector, a NaN Ubar, bad options
+  bad = g;
+  if (d.rank() == 0) bad.w[0] = NAN;
+  EXPECT_THROW((void)distributed::solve_hopf(d, bad, o), input_error);
+  bad = g;
+  bad.p.setZero();
+  EXPECT_TRUE(test::contains(test::input_error_of([&] { (void)distributed::solve_hopf(d, bad, o); }), "zero"));
+  bad = g;
+  bad.mu = NAN;
+  EXPECT_THROW((void)distributed::solve_hopf(d, bad, o), input_error);
+  distributed_hopf_options bo = o;
+  bo.fill_level = -1;
+  EXPECT_TRUE(test::contains(test::input_error_of([&] { (void)distributed::solve_hopf(d, g, bo); }), "fill_level"));
+  // one Newton iteration is not enough: a convergence_error naming the iterate on every rank, or
+  // with throw_on_failure = false a result that holds the last iterate
+  distributed_hopf_options lo = o;
+  lo.hopf.newton.max_iterations = 1;
+  msg = test::error_of<convergence_error>([&] { (void)distributed::solve_hopf(d, g, lo); });
+  EXPECT_TRUE(test::contains(msg, "no convergence in 1 Newton iterations")) << msg;
+  EXPECT_TRUE(test::contains(msg, "iterate 1")) << msg;
+  lo.hopf.newton.throw_on_failure = false;
+  const distributed_hopf_result r = distributed::solve_hopf(d, g, lo);
+  EXPECT_FALSE(r.report.converged);
+  EXPECT_EQ(r.report.iterations, 1);
+  EXPECT_TRUE(std::isfinite(r.point.mu));
+  EXPECT_NE(r.point.mu, g.mu);  // the iterate after the one step
+}
+
+int main(int argc, char** argv) { return aerohopf::test::run_tests_on_ranks(argc, argv); }
