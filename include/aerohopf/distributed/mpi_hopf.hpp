@@ -49,6 +49,7 @@
 #include <Eigen/LU>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <complex>
@@ -177,9 +178,12 @@ class hopf_bordered_preconditioner {
     std::array<double, 2> t{(root ? r[2 * n_] : 0.0) - s_->dot(z1.head(n_)),
                             (root ? r[2 * n_ + 1] : 0.0) - s_->dot(z1.segment(n_, n_))};
     d_->sum(t.data(), 2);
-    const Eigen::Vector2d sol = schur_inv_ * Eigen::Vector2d(t[0], t[1]);
+    // element by element: GCC 12 with AVX-512 warns falsely on fixed 2-vectors mixed with dynamic ones
+    const double s0 = schur_inv_(0, 0) * t[0] + schur_inv_(0, 1) * t[1];
+    const double s1 = schur_inv_(1, 0) * t[0] + schur_inv_(1, 1) * t[1];
+    const std::array<double, 2> sol{s0, s1};
     z.resize(rows());
-    z.head(2 * n_) = z1 - w_ * vec<double>(sol);
+    z.head(2 * n_) = z1 - s0 * w_.col(0) - s1 * w_.col(1);
     z[2 * n_] = d_->rank() == distributed_aerofoil::root ? sol[0] : 0.0;
     z[2 * n_ + 1] = d_->rank() == distributed_aerofoil::root ? sol[1] : 0.0;
   }
