@@ -18,39 +18,20 @@
 #include <aerohopf/flow/naca_cgrid.hpp>
 #include <aerohopf/flow/steady_solver.hpp>
 
+#include "mpi_bench.hpp"
+
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
-#include <fstream>
 #include <string>
 
 using namespace aerohopf;
 
 namespace {
 
-double slowest(double t) {
-  double m = 0;
-  MPI_Allreduce(&t, &m, 1, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD);
-  return m;
-}
-double since(std::chrono::steady_clock::time_point t0) {
-  return slowest(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
-}
-/// The largest resident set of this process so far (VmHWM), in MB; 0 where /proc is not there.
-double peak_resident_mb() {
-  std::ifstream f("/proc/self/status");
-  std::string key;
-  double kb = 0;
-  while (f >> key) {
-    if (key == "VmHWM:") {
-      f >> kb;
-      break;
-    }
-    f.ignore(1 << 12, '\n');
-  }
-  return kb / 1024.0;
-}
+double slowest(double t) { return bench::seconds_max(MPI_COMM_WORLD, t); }
+double since(std::chrono::steady_clock::time_point t0) { return bench::seconds_since(MPI_COMM_WORLD, t0); }
 
 int run(int argc, char** argv, int rank, int size) {
   const int stride = argc > 1 ? std::atoi(argv[1]) : 2;
@@ -105,8 +86,9 @@ int run(int argc, char** argv, int rank, int size) {
   const auto h = distributed::solve_hopf(d, g, ho);
   const double t_hopf = since(t0);
 
-  double mem = peak_resident_mb(), mem_max = 0;
-  MPI_Allreduce(&mem, &mem_max, 1, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD);
+  // collectives: every rank takes part, rank 0 prints
+  const double mem_max = bench::peak_resident_mb_max(MPI_COMM_WORLD);
+  const double t_setup = slowest(h.setup_seconds), t_linear = slowest(h.linear_seconds);
   if (rank == 0) {
     std::printf("ranks,stride,mach,cells,blocks,ubar_star,omega_star,steady_steps,steady_gmres,steady_s,start_iterations,"
                 "start_gmres,start_s,hopf_newton,hopf_gmres,hopf_s,hopf_setup_s,hopf_linear_s,hopf_over_steady,start_plus_hopf_over_steady,"
@@ -114,7 +96,7 @@ int run(int argc, char** argv, int rank, int size) {
     std::printf("%d,%d,%g,%zu,%zu,%.12f,%.12f,%d,%d,%.3f,%d,%ld,%.3f,%d,%ld,%.3f,%.3f,%.3f,%.2f,%.2f,%.0f\n", size, stride,
                 mach, sys.flow().n_cells(), split.grid.topology.cells.size(), h.point.mu, h.point.omega, sr.steps,
                 sr.linear_iterations, t_steady, ep.iterations, ep.linear_iterations, t_start, h.report.iterations,
-                h.linear_iterations, t_hopf, slowest(h.setup_seconds), slowest(h.linear_seconds),
+                h.linear_iterations, t_hopf, t_setup, t_linear,
                 t_hopf / t_steady, (t_start + t_hopf) / t_steady, mem_max);
   }
   return 0;

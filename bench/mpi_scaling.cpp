@@ -23,52 +23,21 @@
 #include <aerohopf/linalg/block_ilu.hpp>
 #include <aerohopf/linalg/krylov.hpp>
 
+#include "mpi_bench.hpp"
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
-#include <fstream>
-#include <functional>
 #include <string>
 
 using namespace aerohopf;
 
 namespace {
 
-double seconds_max(MPI_Comm comm, double t) {
-  double m = 0;
-  MPI_Allreduce(&t, &m, 1, MPI_DOUBLE, MPI_MAX, comm);
-  return m;
-}
-
-/// Best of `repeats` (each the slowest rank's wall time).
-double best(MPI_Comm comm, int repeats, const std::function<void()>& f) {
-  double b = 1e300;
-  for (int k = 0; k < repeats; ++k) {
-    MPI_Barrier(comm);
-    const auto t0 = std::chrono::steady_clock::now();
-    f();
-    b = std::min(b, seconds_max(comm, std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count()));
-  }
-  return b;
-}
-
-/// The largest resident set of this process so far (VmHWM of /proc/self/status), in MB; 0 where
-/// the file is not there.
-double peak_resident_mb() {
-  std::ifstream f("/proc/self/status");
-  std::string key;
-  double kb = 0;
-  while (f >> key) {
-    if (key == "VmHWM:") {
-      f >> kb;
-      break;
-    }
-    f.ignore(1 << 12, '\n');
-  }
-  return kb / 1024.0;
-}
+using bench::best;
+using bench::seconds_max;
 
 }  // namespace
 
@@ -171,8 +140,7 @@ int main(int argc, char** argv) {
       drop = sr.final_residual / sr.initial_residual;
       if (rank == 0 && !sr.converged) std::fprintf(stderr, "mpi_scaling: steady solve: %s\n", sr.reason.c_str());
     }
-    double mem = peak_resident_mb(), mem_max = 0;
-    MPI_Allreduce(&mem, &mem_max, 1, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD);
+    const double mem_max = bench::peak_resident_mb_max(MPI_COMM_WORLD);
     if (rank == 0) {
       std::printf("ranks,stride,cfl,mach,cells,blocks,cells_per_rank_max,imbalance,ghost_cells_max,halo_bytes,residual_s,"
                   "jacobian_s,product_s,bilu_s,gmres_s,gmres_iterations,petsc_setup_s,petsc_solve_s,petsc_iterations,"

@@ -424,7 +424,7 @@ inline eigen_pair inverse_power(distributed_aerofoil& d, const distributed_aerof
   double a_norm = row_sums.size() ? row_sums.maxCoeff() : 0.0;
   Eigen::Vector4d border = a.structure_flow.cwiseAbs().rowwise().sum();
   d.sum(border.data(), 4);
-  internal::check_mpi(MPI_Allreduce(MPI_IN_PLACE, &a_norm, 1, MPI_DOUBLE, MPI_MAX, comm), "MPI_Allreduce");
+  a_norm = internal::max_over_ranks(comm, a_norm);
   a_norm = std::max(a_norm, (border + a.structure.cwiseAbs().rowwise().sum()).maxCoeff());
 
   block_ilu_options io;

@@ -155,7 +155,7 @@ eigen_pair inverse_power(distributed_euler<Dim>& d, const block_sparse_matrix<do
       }
     a_norm = row_sums.size() ? row_sums.maxCoeff() : 0.0;
   });
-  internal::check_mpi(MPI_Allreduce(MPI_IN_PLACE, &a_norm, 1, MPI_DOUBLE, MPI_MAX, comm), "MPI_Allreduce");
+  a_norm = internal::max_over_ranks(comm, a_norm);
   block_ilu_options io;
   io.fill_level = opt.fill_level;
   io.context = "distributed inverse power: block-Jacobi BILU of P - sigma I";

@@ -56,6 +56,19 @@ inline void sum_over_ranks(MPI_Comm comm, std::complex<double>* p, int n) {
   check_mpi(MPI_Allreduce(MPI_IN_PLACE, p, n, MPI_C_DOUBLE_COMPLEX, MPI_SUM, comm), "MPI_Allreduce");
 }
 
+/// The largest v over the ranks of comm, on every rank (collective).
+inline double max_over_ranks(MPI_Comm comm, double v) {
+  check_mpi(MPI_Allreduce(MPI_IN_PLACE, &v, 1, MPI_DOUBLE, MPI_MAX, comm), "MPI_Allreduce");
+  return v;
+}
+
+/// Whether `ok` holds on every rank of comm (collective).
+inline bool on_every_rank(MPI_Comm comm, bool ok) {
+  int v = ok ? 1 : 0;
+  check_mpi(MPI_Allreduce(MPI_IN_PLACE, &v, 1, MPI_INT, MPI_MIN, comm), "MPI_Allreduce");
+  return v == 1;
+}
+
 /// Runs f on every rank; if it throws on any rank, every rank throws (collective).
 template <class F>
 void collective(MPI_Comm comm, const char* what, F&& f) {

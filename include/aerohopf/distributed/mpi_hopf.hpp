@@ -50,7 +50,6 @@
 
 #include <algorithm>
 #include <array>
-#include <chrono>
 #include <cmath>
 #include <complex>
 #include <iomanip>
@@ -92,11 +91,6 @@ struct distributed_hopf_result {
 };
 
 namespace internal {
-
-using hopf_clock = std::chrono::steady_clock;
-inline double since(hopf_clock::time_point t0) {
-  return std::chrono::duration<double>(hopf_clock::now() - t0).count();
-}
 
 /// The real (2n + 2) bordered matrix of the eigen-equations in the real split form on the ranks:
 /// v = [x_r, x_i, a, b] (each rank its parts of x_r and x_i; a, b on the root) ->
@@ -220,21 +214,6 @@ class real_aerofoil_operator {
   const distributed_aerofoil::jacobian_rows* j_;
 };
 
-inline double sum_squares(const distributed_aerofoil& d, double local) {
-  d.sum(&local, 1);
-  return local;
-}
-/// Whether `ok` holds on every rank (collective).
-inline bool on_every_rank(MPI_Comm comm, bool ok) {
-  int v = ok ? 1 : 0;
-  check_mpi(MPI_Allreduce(MPI_IN_PLACE, &v, 1, MPI_INT, MPI_MIN, comm), "MPI_Allreduce");
-  return v == 1;
-}
-inline double global_max(MPI_Comm comm, double v) {
-  check_mpi(MPI_Allreduce(MPI_IN_PLACE, &v, 1, MPI_DOUBLE, MPI_MAX, comm), "MPI_Allreduce");
-  return v;
-}
-
 }  // namespace internal
 
 /// Newton on the Hopf system of a distributed_aerofoil from `guess` (file comment), the
@@ -310,7 +289,7 @@ inline distributed_hopf_result solve_hopf(distributed_aerofoil& d, const distrib
 
   // F_A at the iterate (local parts; border rows on the root) with the Jacobian rows a at (w, mu)
   auto residual = [&]() {
-    const auto t0 = internal::hopf_clock::now();
+    const auto t0 = aerohopf::internal::hopf_clock::now();
     const Eigen::Index off = fixed ? 0 : n;
     vec<double> f = vec<double>::Zero(off + 2 * n + 2);
     if (!fixed) f.head(n) = d.residual(w, mu);
@@ -326,30 +305,31 @@ inline distributed_hopf_result solve_hopf(distributed_aerofoil& d, const distrib
       f[off + 2 * n] = sp[0];
       f[off + 2 * n + 1] = sp[1] - 1.0;
     }
-    res.residual_seconds += internal::since(t0);
+    res.residual_seconds += aerohopf::internal::seconds_since(t0);
     return f;
   };
   auto norm = [&](const vec<double>& f) {
-    const double q = internal::sum_squares(d, f.allFinite() ? f.squaredNorm() : NAN);
+    double q = f.allFinite() ? f.squaredNorm() : NAN;
+    d.sum(&q, 1);
     return std::sqrt(q);
   };
   auto assemble = [&]() {
-    const auto t0 = internal::hopf_clock::now();
+    const auto t0 = aerohopf::internal::hopf_clock::now();
     d.jacobians(w, mu, a, l);
-    res.setup_seconds += internal::since(t0);
+    res.setup_seconds += aerohopf::internal::seconds_since(t0);
   };
   auto precondition = [&]() {
-    const auto t0 = internal::hopf_clock::now();
+    const auto t0 = aerohopf::internal::hopf_clock::now();
     d.set_ubar(l, mu);
     pc.compute(d, l, C(0.0, om));
     if (!fixed) pc_real.compute(d, l, 0.0);
     preconditioned = true;
-    res.setup_seconds += internal::since(t0);
+    res.setup_seconds += aerohopf::internal::seconds_since(t0);
   };
 
   const newton_options& no = ho.newton;
   auto& rep = res.report;
-  const auto t_start = internal::hopf_clock::now();
+  const auto t_start = aerohopf::internal::hopf_clock::now();
   auto where = [&](int k, double fk) {
     return aerohopf::internal::concat(" [iterate ", k, ": ||F|| = ", fk, ", Ubar = ", mu, ", omega = ", om, "]");
   };
@@ -407,7 +387,7 @@ inline distributed_hopf_result solve_hopf(distributed_aerofoil& d, const distrib
       vec<double> dw0, dw1;
       if (!fixed) {
         const internal::real_aerofoil_operator aop(d, a);
-        const auto t0 = internal::hopf_clock::now();
+        const auto t0 = aerohopf::internal::hopf_clock::now();
         dw0 = vec<double>::Zero(n);
         dw1 = vec<double>::Zero(n);
         ko.context = aerohopf::internal::concat(label, ": GMRES on A (flow update dw0) at Newton iteration ", k + 1);
@@ -415,13 +395,13 @@ inline distributed_hopf_result solve_hopf(distributed_aerofoil& d, const distrib
         ko.context = aerohopf::internal::concat(label, ": GMRES on A (flow update dw1) at Newton iteration ", k + 1);
         res.linear_iterations +=
             gmres<double>(aop, pc_real, vec<double>(-d.residual_d_ubar(w, mu)), dw1, ko).iterations;
-        res.linear_seconds += internal::since(t0);
+        res.linear_seconds += aerohopf::internal::seconds_since(t0);
         // (A_w p) dw by central differences of the Jacobian rows at w +- h dw
-        const auto t1 = internal::hopf_clock::now();
-        const double w_inf = internal::global_max(comm, w.cwiseAbs().maxCoeff());
+        const auto t1 = aerohopf::internal::hopf_clock::now();
+        const double w_inf = internal::max_over_ranks(comm, w.cwiseAbs().maxCoeff());
         for (int which = 0; which < 2; ++which) {
           const vec<double>& x = which == 0 ? dw0 : dw1;
-          const double x_inf = internal::global_max(comm, x.size() ? x.cwiseAbs().maxCoeff() : 0.0);
+          const double x_inf = internal::max_over_ranks(comm, x.size() ? x.cwiseAbs().maxCoeff() : 0.0);
           if (!(x_inf > 0)) continue;
           const double h = std::cbrt(std::numeric_limits<double>::epsilon()) * std::max(1.0, w_inf) / x_inf;
           d.jacobian(vec<double>(w + h * x), mu, flow::jacobian_kind::exact, ap);
@@ -440,15 +420,15 @@ inline distributed_hopf_result solve_hopf(distributed_aerofoil& d, const distrib
             mu_col.tail(n) += bp.imag();
           }
         }
-        res.residual_seconds += internal::since(t1);
+        res.residual_seconds += aerohopf::internal::seconds_since(t1);
       }
-      const auto t0 = internal::hopf_clock::now();
+      const auto t0 = aerohopf::internal::hopf_clock::now();
       const internal::hopf_bordered_operator op(d, a, om, std::move(mu_col), pr, pi, s);
       const internal::hopf_bordered_preconditioner bp(pc, d, op);
       vec<double> dx = vec<double>::Zero(2 * n + 2);
       ko.context = aerohopf::internal::concat(label, ": GMRES on the bordered eigen-equations at Newton iteration ", k + 1);
       res.linear_iterations += gmres<double>(op, bp, rhs, dx, ko).iterations;
-      res.linear_seconds += internal::since(t0);
+      res.linear_seconds += aerohopf::internal::seconds_since(t0);
       std::array<double, 2> dm{dx[2 * n], dx[2 * n + 1]};
       d.sum(dm.data(), 2);
       if (!internal::on_every_rank(comm, dx.allFinite()) || !std::isfinite(dm[0]) || !std::isfinite(dm[1]))
@@ -481,7 +461,7 @@ inline distributed_hopf_result solve_hopf(distributed_aerofoil& d, const distrib
       break;
     }
   }
-  rep.seconds = internal::since(t_start);
+  rep.seconds = aerohopf::internal::seconds_since(t_start);
 
   // the point, omega > 0, and the post-checks
   res.point.w = w;
@@ -498,7 +478,9 @@ inline distributed_hopf_result solve_hopf(distributed_aerofoil& d, const distrib
   const double r = std::max(target, fn);
   const double tol_f = fixed ? std::max(ho.equilibrium_tolerance, ho.equilibrium_factor * r) : r;
   const double f_eq = norm(d.residual(w, mu));
-  const double p_norm = std::sqrt(internal::sum_squares(d, res.point.p.squaredNorm()));
+  double p_norm2 = res.point.p.squaredNorm();
+  d.sum(&p_norm2, 1);
+  const double p_norm = std::sqrt(p_norm2);
   std::string why;
   if (!(f_eq <= tol_f))
     why = aerohopf::internal::concat("the equilibrium does not hold at Ubar* = ", mu, ": ||f(w, Ubar*)|| = ", f_eq,
