@@ -39,21 +39,9 @@ models::aerofoil_family family(double alpha_deg) {
   return models::aerofoil_family(flow::naca_cgrid(), p, {}, alpha_deg * std::numbers::pi / 180);
 }
 
-/// This rank's part of a complex vector.
-vec<cd> local_part(distributed_aerofoil& d, const vec<cd>& g) {
-  const vec<double> re = d.local_part(vec<double>(g.real())), im = d.local_part(vec<double>(g.imag()));
-  vec<cd> x(re.size());
-  x.real() = re;
-  x.imag() = im;
-  return x;
-}
-vec<cd> gather(distributed_aerofoil& d, const vec<cd>& local) {
-  const vec<double> re = d.all_gather(vec<double>(local.real())), im = d.all_gather(vec<double>(local.imag()));
-  vec<cd> x(re.size());
-  x.real() = re;
-  x.imag() = im;
-  return x;
-}
+/// This rank's part of a complex vector, and the whole from the parts.
+vec<cd> local_part(distributed_aerofoil& d, const vec<cd>& g) { return d.local_part(g); }
+vec<cd> gather(distributed_aerofoil& d, const vec<cd>& local) { return d.all_gather(local); }
 /// ||p - c q|| / ||p|| with c the best complex scale: the same eigenvector up to normalisation.
 double eigenvector_distance(const vec<cd>& p, const vec<cd>& q) {
   const cd c = q.dot(p) / q.squaredNorm();

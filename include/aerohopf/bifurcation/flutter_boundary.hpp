@@ -85,7 +85,13 @@ namespace aerohopf {
 /// - `stiffness_factor(mu)`: q(mu) with A(mu) = A0 + q(mu) B, B in the structural block, and
 ///   its inverse `parameter_of_factor(q)` > 0 (the crossing check; the aerofoil: q = 1/Ubar^2);
 /// - optionally `coarser_level(level)` -> std::optional<int>: the next coarser level that refines
-///   to `level` (flutter_boundary_options::coarser_level_bridge), empty on the coarsest.
+///   to `level` (flutter_boundary_options::coarser_level_bridge), empty on the coarsest;
+/// - optionally its own solvers, used instead of the serial Krylov ones for every point and start
+///   (e.g. on MPI ranks, distributed/mpi_aerofoil_family.hpp): `solve_hopf(s, guess,
+///   hopf_options, hopf_krylov_options)` -> hopf_result for solve_hopf_krylov, and
+///   `hopf_start(s, w, mu, omega, hopf_start_krylov_options, eigen_pair*)` -> hopf_point for
+///   hopf_start_krylov. The driver itself (predictions, mode test, tracer hand-over, crossing
+///   check) then runs on every rank alike, on the whole vectors those return.
 template <class F>
 concept flutter_family = aeroelastic_system<typename F::system_type> &&
                          requires(const F& f, const typename F::system_type& s, int level, double mach,
@@ -367,6 +373,33 @@ vec<double> family_equilibrium_near(const F& f, const typename F::system_type& s
     return f.equilibrium(s, mu);
 }
 
+/// The Hopf solve of a point: the family's own `solve_hopf(s, guess, hopf_options,
+/// hopf_krylov_options)` where it has one (e.g. on MPI ranks: distributed/mpi_aerofoil_family.hpp),
+/// else solve_hopf_krylov with the family's block size.
+template <flutter_family F>
+hopf_result family_solve_hopf(const F& f, const typename F::system_type& s, const hopf_point& guess,
+                              const hopf_options& ho, const hopf_krylov_options& ko) {
+  if constexpr (requires {
+                  { f.solve_hopf(s, guess, ho, ko) } -> std::convertible_to<hopf_result>;
+                })
+    return f.solve_hopf(s, guess, ho, ko);
+  else
+    return solve_hopf_krylov<F::block_size>(s, guess, ho, ko);
+}
+
+/// The inverse-power start at (w, mu), shift i omega: the family's own `hopf_start(s, w, mu, omega,
+/// hopf_start_krylov_options, eigen_pair*)` where it has one, else hopf_start_krylov.
+template <flutter_family F>
+hopf_point family_hopf_start(const F& f, const typename F::system_type& s, const vec<double>& w, double mu,
+                             double omega, const hopf_start_krylov_options& so, eigen_pair* info) {
+  if constexpr (requires {
+                  { f.hopf_start(s, w, mu, omega, so, info) } -> std::convertible_to<hopf_point>;
+                })
+    return f.hopf_start(s, w, mu, omega, so, info);
+  else
+    return hopf_start_krylov<F::block_size>(s, w, mu, omega, so, info);
+}
+
 struct moving_scan_result {
   vg_result vg;
   std::map<double, vec<double>> equilibria;  ///< every equilibrium the scan solved, by mu
@@ -469,7 +502,6 @@ inline hopf_start_krylov_options krylov_start_options(const flutter_boundary_opt
 template <flutter_family F>
 std::pair<double, double> moving_crossing_sides(const F& f, const typename F::system_type& s, const hopf_point& h,
                                                 const flutter_boundary_options& o) {
-  constexpr int B = F::block_size;
   require(h.w.size() == s.size(), o.label, ": crossing sides: the Hopf point's equilibrium has ", h.w.size(),
           " entries for a system of ", s.size());
   const hopf_start_krylov_options so = krylov_start_options(o, o.scan_tolerance);
@@ -477,7 +509,7 @@ std::pair<double, double> moving_crossing_sides(const F& f, const typename F::sy
   auto re_at = [&](double m) {
     const vec<double> w = family_equilibrium_near(f, s, h.w, mu, m);
     eigen_pair ep;
-    hopf_start_krylov<B>(s, w, m, h.omega, so, &ep);
+    internal::family_hopf_start(f, s, w, m, h.omega, so, &ep);
     return ep.lambda.real();
   };
   return {re_at((1 - o.scan_delta) * mu), re_at((1 + o.scan_delta) * mu)};
@@ -578,7 +610,8 @@ class flutter_boundary_tracer {
     hopf_options ho = hopf_opts(label, !o_.moving_equilibrium);
     const auto t0 = clk::now();
     try {
-      hopf_result h = o_.moving_equilibrium ? full_hopf(s, g, st.mu, ho, ko, label) : solve_hopf_krylov<B>(s, g, ho, ko);
+      hopf_result h = o_.moving_equilibrium ? full_hopf(s, g, st.mu, ho, ko, label)
+                                            : internal::family_solve_hopf(f_, s, g, ho, ko);
       if (o_.parameter_even) h.point.mu = std::abs(h.point.mu);
       if (!(h.point.mu >= o_.mu_min))
         throw convergence_error(concat(label, ": converged to mu* = ", h.point.mu, " (omega* = ", h.point.omega,
@@ -615,7 +648,7 @@ class flutter_boundary_tracer {
   hopf_result full_hopf(const S& s, hopf_point g, double mu_w, const hopf_options& ho, const hopf_krylov_options& ko,
                         const std::string& label) {
     try {
-      return solve_hopf_krylov<B>(s, g, ho, ko);
+      return internal::family_solve_hopf(f_, s, g, ho, ko);
     } catch (const error& e) {
       flutter_say(log_, "    %s: %s\n    -> again from the fixed point of the frozen-flow map (secant)\n", label.c_str(),
                   e.what());
@@ -627,7 +660,7 @@ class flutter_boundary_tracer {
     kf.fill_level = o_.fill_level;
     // mu'(mu) at g.w = w_s(mu): g's eigenvector and frequency are updated as a start for the next
     auto frozen = [&](hopf_point& h) {
-      const hopf_result r = solve_hopf_krylov<B>(s, h, fo, kf);
+      const hopf_result r = internal::family_solve_hopf(f_, s, h, fo, kf);
       h.p = r.point.p;
       h.omega = r.point.omega;
       return o_.parameter_even ? std::abs(r.point.mu) : r.point.mu;
@@ -654,7 +687,7 @@ class flutter_boundary_tracer {
       mu1 = mu2;
     }
     g.mu = mu1;
-    hopf_result h = solve_hopf_krylov<B>(s, g, ho, ko);
+    hopf_result h = internal::family_solve_hopf(f_, s, g, ho, ko);
     // The frozen-flow map leads to the Hopf point nearest its start, which can be one where g
     // FALLS through zero (NACA 0012 medium, alpha_0 = 1 deg, M = 0.65: Ubar = 1.57627, above the
     // onset at 1.5151 where g rises): not a flutter onset, so a failed attempt.
@@ -708,7 +741,7 @@ class flutter_boundary_tracer {
       if (below != r.equilibria.begin()) --below;
       const vec<double> wc = equilibrium_near(s, below->second, below->first, mu_c);
       eigen_pair ep;
-      hopf_point guess = hopf_start_krylov<B>(s, wc, mu_c, omega_c, start_options(), &ep);
+      hopf_point guess = internal::family_hopf_start(f_, s, wc, mu_c, omega_c, start_options(), &ep);
       guess.mu = mu_c;
       flutter_say(log_, "    %s: lowest rising zero of g (mode %d) at mu = %.5f, omega = %.5f; inverse power there: "
                   "lambda = %+.6f %+.6fi\n", label.c_str(), r.lowest->mode, mu_c, omega_c, ep.lambda.real(), ep.lambda.imag());
@@ -1178,7 +1211,7 @@ flutter_boundary flutter_boundary_tracer<F>::run() {
       } else {
         eigen_pair ep;
         const auto ts = clk::now();
-        guess = hopf_start_krylov<B>(s, st.w, o_.start_mu, o_.start_omega, start_options(), &ep);
+        guess = internal::family_hopf_start(f_, s, st.w, o_.start_mu, o_.start_omega, start_options(), &ep);
         flutter_say(log_, "    inverse power (BILU(%d)-GMRES): lambda = %+.6f %+.6fi, %d iterations, %ld GMRES, %.2f s\n",
                     o_.fill_level, ep.lambda.real(), ep.lambda.imag(), ep.iterations, ep.linear_iterations,
                     flutter_seconds_since(ts));

@@ -91,6 +91,14 @@ class distributed_aerofoil {
     return global;
   }
 
+  /// The same for a complex vector (an eigenvector), by its real and imaginary parts.
+  vec<std::complex<double>> local_part(const vec<std::complex<double>>& global) const {
+    return join(local_part(vec<double>(global.real())), local_part(vec<double>(global.imag())));
+  }
+  vec<std::complex<double>> all_gather(const vec<std::complex<double>>& local) {
+    return join(all_gather(vec<double>(local.real())), all_gather(vec<double>(local.imag())));
+  }
+
   /// f(w, Ubar) in this rank's part (collective).
   vec<double> residual(const vec<double>& local, double ubar) {
     check_state(local, ubar, "distributed_aerofoil::residual");
@@ -283,6 +291,13 @@ class distributed_aerofoil {
     internal::collective(comm_, who, [&] {
       require_size(local.size(), local_size(), who, "local vector (this rank's flow values and 4 structural)");
     });
+  }
+
+  static vec<std::complex<double>> join(const vec<double>& re, const vec<double>& im) {
+    vec<std::complex<double>> z(re.size());
+    z.real() = re;
+    z.imag() = im;
+    return z;
   }
 
   const models::aerofoil_system& sys_;

@@ -175,6 +175,7 @@ class aerofoil_family {
   const structure::pitch_plunge_parameters& structure() const { return structure_; }
   double alpha() const { return alpha_; }
   flow::steady_options& steady_options() { return steady_; }
+  const flow::steady_options& steady_options() const { return steady_; }
 
  private:
   flow::multiblock_grid<2> fine_;

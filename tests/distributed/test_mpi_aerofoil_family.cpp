@@ -1,0 +1,131 @@
+// The pitch-plunge aerofoil's flutter family with its solves on MPI ranks
+// (distributed/mpi_aerofoil_family.hpp), run by CTest under mpirun on 2 and 3 ranks, against the
+// serial family (models::aerofoil_family) on the very coarse grid, light case:
+//  * the equilibrium (steady flow on the ranks, gathered) is the serial steady equilibrium to the
+//    stopping test's accuracy;
+//  * the inverse-power start at Ubar = 1.66, shift 0.75i is the serial hopf_start_krylov's
+//    eigenvalue to 1e-8;
+//  * the flutter boundary by trace_flutter_boundary at M = 0.5, 0.55, 0.6, 0.65 (first point
+//    from inverse power, then natural continuation with the mode test, the crossing check; Newton
+//    to ||F|| <= 1e-10) has the serial boundary's Ubar* and omega* to 1e-8 relative at every Mach
+//    number, and every rank holds the same boundary;
+//  * a mean incidence is refused (its static equilibrium is not solved on the ranks).
+#include <gtest/gtest.h>
+#include <mpi.h>
+
+#include <aerohopf/bifurcation/flutter_boundary.hpp>
+#include <aerohopf/distributed/mpi_aerofoil_family.hpp>
+#include <aerohopf/flow/naca_cgrid.hpp>
+#include <aerohopf/models/aerofoil_family.hpp>
+
+#include <cmath>
+#include <complex>
+#include <iomanip>
+#include <iostream>
+#include <string>
+#include <vector>
+
+#include "support/error_messages.hpp"
+#include "support/mpi_test.hpp"
+
+using namespace aerohopf;
+using aerohopf::test::world_size;
+
+namespace {
+
+models::aerofoil_family serial_family(double alpha_rad = 0.0) {
+  structure::pitch_plunge_parameters p;
+  p.mu_s = 10;
+  return models::aerofoil_family(flow::naca_cgrid(), p, {}, alpha_rad);
+}
+
+int rank() {
+  int r = 0;
+  MPI_Comm_rank(MPI_COMM_WORLD, &r);
+  return r;
+}
+
+/// The same value on every rank (bitwise).
+bool same_on_every_rank(double x) {
+  double lo = 0, hi = 0;
+  MPI_Allreduce(&x, &lo, 1, MPI_DOUBLE, MPI_MIN, MPI_COMM_WORLD);
+  MPI_Allreduce(&x, &hi, 1, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD);
+  return lo == hi;
+}
+
+constexpr int very_coarse = 8;
+
+}  // namespace
+
+TEST(mpi_aerofoil_family, equilibrium_and_start_equal_the_serial_ones) {
+  const auto serial = serial_family();
+  const distributed::aerofoil_family dist(serial, MPI_COMM_WORLD);
+  const models::aerofoil_system s = serial.system(very_coarse, 0.6);
+  const vec<double> ws = serial.equilibrium(s, 1.66);
+  const vec<double> wd = dist.equilibrium(s, 1.66);
+  ASSERT_EQ(wd.size(), ws.size());
+  // both converged by the same stopping test; only the preconditioner differs
+  EXPECT_LT((wd - ws).norm(), 1e-8 * ws.norm());
+  EXPECT_LT(s.residual(wd, 1.66).norm(), 1e-9);
+  EXPECT_TRUE(same_on_every_rank(wd.sum()));
+
+  hopf_start_krylov_options so;
+  so.fill_level = 2;
+  so.inverse_power.tolerance = 1e-10;
+  eigen_pair es, ed;
+  const hopf_point hs = hopf_start_krylov<4>(s, ws, 1.66, 0.75, so, &es);
+  const hopf_point hd = dist.hopf_start(s, ws, 1.66, 0.75, so, &ed);
+  EXPECT_LT(std::abs(ed.lambda - es.lambda), 1e-8 * std::abs(es.lambda)) << ed.lambda << " vs " << es.lambda;
+  EXPECT_LT(std::abs(hd.omega - hs.omega), 1e-8 * hs.omega);
+  EXPECT_GT(hd.omega, 0.0);
+  ASSERT_EQ(hd.p.size(), s.size());
+  // the same eigenvector up to its complex scale
+  const std::complex<double> c = hs.p.dot(hd.p) / hs.p.squaredNorm();
+  EXPECT_LT((hd.p - c * hs.p).norm(), 1e-7 * hd.p.norm());
+  EXPECT_EQ(hd.w, ws);
+}
+
+TEST(mpi_aerofoil_family, flutter_boundary_equals_the_serial_one) {
+  const auto serial = serial_family();
+  const distributed::aerofoil_family dist(serial, MPI_COMM_WORLD);
+  const std::vector<double> machs{0.5, 0.55, 0.6, 0.65};
+  flutter_boundary_options o = serial.boundary_options();
+  o.start_mu = 1.66;
+  o.start_omega = 0.75;
+  // Newton to ||F|| <= 1e-10 (the driver's default 1e-7 leaves Ubar* a few 1e-8 from the limit,
+  // differently on the ranks, whose GMRES iterates differ)
+  o.tolerance = 1e-10;
+  o.log = nullptr;
+  o.label = "light very coarse";
+  const flutter_boundary ref = trace_flutter_boundary(serial, very_coarse, machs, nullptr, o);
+  o.log = rank() == 0 ? &std::cout : nullptr;
+  o.label = "light very coarse on " + std::to_string(world_size()) + " ranks";
+  const flutter_boundary b = trace_flutter_boundary(dist, very_coarse, machs, nullptr, o);
+  ASSERT_TRUE(ref.complete) << ref.stop_reason;
+  ASSERT_TRUE(b.complete) << b.stop_reason;
+  ASSERT_EQ(b.points.size(), ref.points.size());
+  for (std::size_t k = 0; k < b.points.size(); ++k) {
+    const auto &p = b.points[k], &q = ref.points[k];
+    EXPECT_EQ(p.mach, q.mach);
+    EXPECT_LT(std::abs(p.mu - q.mu), 1e-8 * q.mu) << "M = " << p.mach << ": Ubar* " << p.mu << " vs " << q.mu;
+    EXPECT_LT(std::abs(p.omega - q.omega), 1e-8 * q.omega) << "M = " << p.mach;
+    EXPECT_TRUE(same_on_every_rank(p.mu)) << "M = " << p.mach;
+    EXPECT_GT(p.linear_iterations, 0);
+    if (rank() == 0)
+      std::cout << "M = " << p.mach << ": Ubar* " << std::setprecision(12) << p.mu << " (serial " << q.mu << "), omega* "
+                << p.omega << " (serial " << q.omega << "), " << p.newton_iterations << " Newton / "
+                << p.linear_iterations << " GMRES (serial " << q.newton_iterations << " / " << q.linear_iterations
+                << ")\n";
+  }
+  EXPECT_EQ(b.checks.size(), ref.checks.size());
+  EXPECT_TRUE(b.checks_passed());
+}
+
+TEST(mpi_aerofoil_family, a_mean_incidence_is_refused_on_every_rank) {
+  const auto serial = serial_family(0.01);
+  const std::string e =
+      aerohopf::test::input_error_of([&] { const distributed::aerofoil_family d(serial, MPI_COMM_WORLD); });
+  EXPECT_TRUE(aerohopf::test::contains(e, "not solved on the ranks")) << e;
+}
+
+int main(int argc, char** argv) { return aerohopf::test::run_tests_on_ranks(argc, argv); }
