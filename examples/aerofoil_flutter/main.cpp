@@ -67,45 +67,12 @@ using namespace aerofoil_example;
 
 namespace aerofoil_example {
 
-/// The driver's options: the family's (aerofoil_family::boundary_options) with the case's start
-/// guess and the user's choices.
-flutter_boundary_options driver_options(const options& o, const structural_case& c, const grid_level& g,
-                                        const models::aerofoil_family& family) {
-  flutter_boundary_options fo = family.boundary_options();
-  fo.start_mu = c.ubar_guess;
-  fo.start_omega = c.omega_guess;
-  fo.fill_level = o.fill;
-  fo.verbose = o.verbose;
-  fo.label = c.name + " " + g.name;
-  // the crossing check factorises i omega I - A_ff at every sampled frequency: ~1 s per LU on
-  // the medium grid, so there only with --crossing-medium; at an incidence it is a V-g scan
-  // (inverse powers by sparse LU up to 20,000 unknowns), on every grid
-  fo.check_crossings = o.crossing_check && (g.stride >= 4 || (g.stride == 2 && o.crossing_medium) ||
-                                            family.alpha() != 0.0);
-  return fo;
-}
-
 flutter_boundary boundary_on(const options& o, const structural_case& c, const grid_level& g,
                              const flutter_boundary* coarser) {
   const auto machs = mach_list(o);
   const auto family = family_of(c, o.incidence_deg * std::numbers::pi / 180);
   flutter_boundary b = trace_flutter_boundary(family, g.stride, machs, coarser, driver_options(o, c, g, family));
-  const bool moving = o.incidence_deg != 0.0;
-  char tag[64] = "";
-  if (moving) std::snprintf(tag, sizeof tag, "_alpha%g", o.incidence_deg);
-  csv_writer csv(o.out / ("boundary_" + c.name + "_" + g.name + tag + ".csv"),
-                 std::string("mach,ubar,omega,newton_iterations,linear_iterations,hopf_seconds,steady_seconds") +
-                     (moving ? ",static_alpha" : ""));
-  for (const auto& p : b.points) {
-    // the pitch unknown of the equilibrium at the flutter point (h, h', alpha, alpha' last)
-    const double static_alpha = p.point.w[p.point.w.size() - 2];
-    if (moving)
-      csv.row({p.mach, p.mu, p.omega, static_cast<long long>(p.newton_iterations),
-               static_cast<long long>(p.linear_iterations), p.hopf_seconds, p.steady_seconds, static_alpha});
-    else
-      csv.row({p.mach, p.mu, p.omega, static_cast<long long>(p.newton_iterations),
-               static_cast<long long>(p.linear_iterations), p.hopf_seconds, p.steady_seconds});
-  }
+  write_boundary(o, c, g, b);
   if (!b.complete) std::cout << "  " << b.label << ": boundary incomplete: " << b.stop_reason << "\n";
   if (b.complete && !b.skipped.empty()) std::cout << "  " << b.label << ": " << b.stop_reason << "\n";
   return b;

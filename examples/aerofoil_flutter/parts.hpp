@@ -130,6 +130,45 @@ inline std::optional<flutter_boundary_point> single_hopf_point(const options& o,
   }
 }
 
+/// The driver's options: the family's (aerofoil_family::boundary_options) with the case's start
+/// guess and the user's choices.
+inline flutter_boundary_options driver_options(const options& o, const structural_case& c, const grid_level& g,
+                                               const models::aerofoil_family& family) {
+  flutter_boundary_options fo = family.boundary_options();
+  fo.start_mu = c.ubar_guess;
+  fo.start_omega = c.omega_guess;
+  fo.fill_level = o.fill;
+  fo.verbose = o.verbose;
+  fo.label = c.name + " " + g.name;
+  // the crossing check factorises i omega I - A_ff at every sampled frequency: ~1 s per LU on
+  // the medium grid, so there only with --crossing-medium; at an incidence it is a V-g scan
+  // (inverse powers by sparse LU up to 20,000 unknowns), on every grid
+  fo.check_crossings = o.crossing_check && (g.stride >= 4 || (g.stride == 2 && o.crossing_medium) ||
+                                            family.alpha() != 0.0);
+  return fo;
+}
+
+/// boundary_<case>_<grid>.csv (at an incidence boundary_<case>_<grid>_alpha<DEG>.csv with the
+/// static pitch deflection) of boundary b.
+inline void write_boundary(const options& o, const structural_case& c, const grid_level& g, const flutter_boundary& b) {
+  const bool moving = o.incidence_deg != 0.0;
+  char tag[64] = "";
+  if (moving) std::snprintf(tag, sizeof tag, "_alpha%g", o.incidence_deg);
+  csv_writer csv(o.out / ("boundary_" + c.name + "_" + g.name + tag + ".csv"),
+                 std::string("mach,ubar,omega,newton_iterations,linear_iterations,hopf_seconds,steady_seconds") +
+                     (moving ? ",static_alpha" : ""));
+  for (const auto& p : b.points) {
+    // the pitch unknown of the equilibrium at the flutter point (h, h', alpha, alpha' last)
+    const double static_alpha = p.point.w[p.point.w.size() - 2];
+    if (moving)
+      csv.row({p.mach, p.mu, p.omega, static_cast<long long>(p.newton_iterations),
+               static_cast<long long>(p.linear_iterations), p.hopf_seconds, p.steady_seconds, static_alpha});
+    else
+      csv.row({p.mach, p.mu, p.omega, static_cast<long long>(p.newton_iterations),
+               static_cast<long long>(p.linear_iterations), p.hopf_seconds, p.steady_seconds});
+  }
+}
+
 /// The boundary of case c on grid g (main.cpp), from the coarser grid's if given.
 flutter_boundary boundary_on(const options& o, const structural_case& c, const grid_level& g,
                              const flutter_boundary* coarser);

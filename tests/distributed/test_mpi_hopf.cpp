@@ -8,8 +8,10 @@
 //  * full formulation (mean incidence 1 deg: the static pitch deflection moves with Ubar): from
 //    the static equilibrium at Ubar = 1.7, Ubar*, omega* and the moving equilibrium w* equal the
 //    serial full Krylov solve's; the fixed-equilibrium formulation refuses that equilibrium;
-//  * bad input is refused on every rank and a Newton limit reached is a convergence_error on
-//    every rank, or a result not converged holding the last iterate.
+//  * the start refinement (an eigenvector 30 % off: one inverse iteration) is kept as in the
+//    serial solve, lowers the start's ||F|| and reaches the serial point;
+//  * bad input is refused on every rank and a Newton limit reached (iterations, contraction) is
+//    a convergence_error on every rank, or a result not converged holding the last iterate.
 #include <gtest/gtest.h>
 #include <mpi.h>
 
@@ -17,6 +19,7 @@
 #include <aerohopf/distributed/mpi_hopf.hpp>
 #include <aerohopf/models/aerofoil_family.hpp>
 
+#include <cmath>
 #include <complex>
 #include <iostream>
 #include <numbers>
@@ -146,6 +149,45 @@ TEST(mpi_hopf, full_formulation_equals_the_serial_full_krylov_solve) {
   EXPECT_TRUE(test::contains(msg, "equilibrium does not hold")) << msg;
 }
 
+TEST(mpi_hopf, start_refinement_as_the_serial_one) {
+  const auto f = family(0.0);
+  const models::aerofoil_system sys = f.system(8, 0.5);
+  const vec<double> w = sys.steady_equilibrium();
+  hopf_point start = hopf_start(sys, w, 1.75, 0.6);
+  // an eigenvector far off (a smooth perturbation of 30 % of its size), as a continued guess
+  // across a shock's motion is
+  const double scale = 0.3 * start.p.norm() / std::sqrt(static_cast<double>(start.p.size()));
+  for (Eigen::Index i = 0; i < start.p.size(); ++i)
+    start.p[i] += scale * cd(std::sin(0.37 * static_cast<double>(i)), std::cos(0.11 * static_cast<double>(i)));
+  hopf_options opt;
+  opt.fixed_equilibrium = true;
+  hopf_krylov_options ko;
+  ko.start_iterations = 1;
+  const hopf_result ref = solve_hopf_krylov<4>(sys, start, opt, ko);
+  ASSERT_TRUE(ref.report.converged);
+  EXPECT_TRUE(ref.start_refined);
+
+  distributed_aerofoil d(sys, partition_blocks(sys.flow(), world_size()), MPI_COMM_WORLD);
+  distributed_hopf_options o;
+  o.hopf = opt;
+  o.start_iterations = 1;
+  const distributed_hopf_result r = distributed::solve_hopf(d, local_guess(d, start), o);
+  ASSERT_TRUE(r.report.converged) << r.report.reason;
+  EXPECT_TRUE(r.start_refined);
+  // the refined start is nearer: ||F|| of the start below the unrefined one's
+  o.start_iterations = 0;
+  const distributed_hopf_result u = distributed::solve_hopf(d, local_guess(d, start), o);
+  ASSERT_TRUE(u.report.converged) << u.report.reason;
+  EXPECT_FALSE(u.start_refined);
+  EXPECT_LT(r.report.residual_history.front(), u.report.residual_history.front());
+  EXPECT_LT(std::abs(r.point.mu - ref.point.mu), 1e-9 * ref.point.mu) << r.point.mu << " vs " << ref.point.mu;
+  EXPECT_LT(std::abs(r.point.omega - ref.point.omega), 1e-9 * ref.point.omega);
+  // a threshold above the start's ||F||: no refinement
+  o.start_iterations = 1;
+  o.start_residual_threshold = 1e6;
+  EXPECT_FALSE(distributed::solve_hopf(d, local_guess(d, start), o).start_refined);
+}
+
 TEST(mpi_hopf, bad_input_and_failures_are_the_same_on_every_rank) {
   const auto f = family(0.0);
   const models::aerofoil_system sys = f.system(8, 0.5);
@@ -174,6 +216,14 @@ TEST(mpi_hopf, bad_input_and_failures_are_the_same_on_every_rank) {
   distributed_hopf_options bo = o;
   bo.fill_level = -1;
   EXPECT_TRUE(test::contains(test::input_error_of([&] { (void)distributed::solve_hopf(d, g, bo); }), "fill_level"));
+  bo = o;
+  bo.start_tolerance = 1.0;
+  EXPECT_TRUE(test::contains(test::input_error_of([&] { (void)distributed::solve_hopf(d, g, bo); }), "start_tolerance"));
+  bo = o;
+  bo.hopf.fixed_equilibrium = false;
+  bo.start_iterations = 1;
+  EXPECT_TRUE(test::contains(test::input_error_of([&] { (void)distributed::solve_hopf(d, g, bo); }),
+                             "only in the fixed-equilibrium formulation"));
   // one Newton iteration is not enough: a convergence_error naming the iterate on every rank, or
   // with throw_on_failure = false a result that holds the last iterate
   distributed_hopf_options lo = o;
@@ -187,6 +237,13 @@ TEST(mpi_hopf, bad_input_and_failures_are_the_same_on_every_rank) {
   EXPECT_EQ(r.report.iterations, 1);
   EXPECT_TRUE(std::isfinite(r.point.mu));
   EXPECT_NE(r.point.mu, g.mu);  // the iterate after the one step
+  // the contraction test (as newton_options): a step that leaves ||F|| above max_contraction
+  // times the one before fails at once, as the serial Newton does (a start outside the basin)
+  distributed_hopf_options co = o;
+  co.hopf.newton.max_contraction = 1e-12;
+  co.hopf.newton.contraction_from = 1;
+  msg = test::error_of<convergence_error>([&] { (void)distributed::solve_hopf(d, g, co); });
+  EXPECT_TRUE(test::contains(msg, "not contracting at iterate 1")) << msg;
 }
 
 int main(int argc, char** argv) { return aerohopf::test::run_tests_on_ranks(argc, argv); }

@@ -17,9 +17,8 @@
 // Each level's C-grid is partitioned by whole blocks (partition_blocks: 3 blocks, so 1 to 3
 // ranks), the same cells as the serial numbering, so the boundary equals the serial one to the
 // solvers' tolerances; only the preconditioner (block Jacobi across the ranks) and hence the
-// linear iterations differ. The serial solve_hopf_krylov's start refinement
-// (hopf_krylov_options::start_iterations) is not done on the ranks: Newton starts from the
-// driver's guess.
+// linear iterations differ; the serial solve_hopf_krylov's start refinement
+// (hopf_krylov_options::start_iterations, threshold and tolerance) is done on the ranks alike.
 // Zero incidence only: the static aeroelastic equilibrium of a mean incidence (the full
 // formulation's moving equilibrium) is not yet solved on the ranks, so such a family is refused.
 #include <mpi.h>
@@ -122,6 +121,10 @@ class aerofoil_family {
     o.krylov.restart = ko.krylov.restart;
     o.krylov.max_iterations = ko.krylov.max_iterations;
     o.eta_max = ko.eta_max;
+    o.start_iterations = ko.start_iterations;
+    o.start_tolerance = ko.start_tolerance;
+    o.start_max_iterations = ko.start_max_iterations;
+    o.start_residual_threshold = ko.start_residual_threshold;
     distributed_hopf_point g{d.local_part(guess.w), guess.mu, guess.omega, d.local_part(guess.p)};
     const distributed_hopf_result r = distributed::solve_hopf(d, g, o);
     hopf_result h;
@@ -139,6 +142,7 @@ class aerofoil_family {
     h.setup_seconds = r.setup_seconds;
     h.linear_seconds = r.linear_seconds;
     h.residual_seconds = r.residual_seconds;
+    h.start_refined = r.start_refined;
     return h;
   }
 

@@ -31,10 +31,16 @@
 // preconditioner is computed at the start and again after a step that reduced ||F|| less than
 // tenfold; in the full formulation everything is re-assembled at every iterate (A moves with w).
 //
+// Start refinement (fixed formulation, distributed_hopf_options::start_iterations, as the serial
+// solve_hopf_krylov's): a continued guess whose eigenvector is far off (||F|| above a threshold)
+// is first improved by inverse iteration at i omega with the Newton preconditioner; omega is then
+// the Rayleigh quotient's imaginary part, and the refined start is kept if ||F|| drops.
+//
 // Stopping and checks (as hopf.hpp, sums over the ranks): ||F_A|| <= abs_tolerance +
 // rel_tolerance ||F_A(start)|| (hopf_options::newton; its rounding-floor test is not used);
 // failure (convergence_error on every rank, naming the iterate, ||F||, Ubar and omega) on a
-// non-finite or diverging residual (> divergence_factor ||F_0||), a GMRES failure, or the
+// non-finite or diverging residual (> divergence_factor ||F_0||), a residual that grows more than
+// max_contraction-fold in one step from iteration contraction_from on, a GMRES failure, or the
 // iteration limit; with newton.throw_on_failure = false the result holds the last iterate
 // instead, report.converged = false. A converged point is accepted if the equilibrium holds at
 // Ubar* (fixed formulation: ||f(w, Ubar*)|| <= max(equilibrium_tolerance, equilibrium_factor
@@ -74,6 +80,15 @@ struct distributed_hopf_options {
     return o;
   }();
   double eta_max = 1e-2;
+  /// Start refinement (fixed formulation; as hopf_krylov_options): where ||F(guess)|| >
+  /// start_residual_threshold, start_iterations inverse iterations at i omega from the guess's p
+  /// (complex GMRES to start_tolerance, at most start_max_iterations, with the Newton
+  /// preconditioner), omega from the Rayleigh quotient; the refined start is kept if its ||F|| is
+  /// smaller. 0: off.
+  int start_iterations = 0;
+  double start_tolerance = 1e-2;
+  int start_max_iterations = 100;
+  double start_residual_threshold = 0.0;
 };
 
 /// A Hopf point's guess or result on the ranks: this rank's parts of w and p.
@@ -88,6 +103,7 @@ struct distributed_hopf_result {
   newton_report report;
   long linear_iterations = 0;    ///< GMRES iterations over all solves
   double setup_seconds = 0, linear_seconds = 0, residual_seconds = 0;
+  bool start_refined = false;    ///< the start refinement (start_iterations) was kept
 };
 
 namespace internal {
@@ -237,6 +253,15 @@ inline distributed_hopf_result solve_hopf(distributed_aerofoil& d, const distrib
     require(opt.fill_level >= 0 && opt.fill_level <= 8, who, ": fill_level must lie in [0, 8] (got ", opt.fill_level,
             ")");
     require(opt.eta_max > 0 && opt.eta_max < 1, who, ": eta_max must lie in (0, 1) (got ", opt.eta_max, ")");
+    require(opt.start_iterations >= 0, who, ": start_iterations must be >= 0 (got ", opt.start_iterations, ")");
+    require(opt.start_tolerance > 0 && opt.start_tolerance < 1, who, ": start_tolerance must lie in (0, 1) (got ",
+            opt.start_tolerance, ")");
+    require(opt.start_max_iterations >= 1, who, ": start_max_iterations must be >= 1 (got ", opt.start_max_iterations,
+            ")");
+    require(std::isfinite(opt.start_residual_threshold) && opt.start_residual_threshold >= 0, who,
+            ": start_residual_threshold must be finite and >= 0 (got ", opt.start_residual_threshold, ")");
+    require(fixed || opt.start_iterations == 0, who, ": the start refinement (start_iterations = ", opt.start_iterations,
+            ") is available only in the fixed-equilibrium formulation; set it to 0");
     require_size(guess.w.size(), n, who, "guess.w (this rank's flow values and 4 structural)");
     require_size(guess.p.size(), n, who, "guess.p (this rank's part of the eigenvector)");
     require_finite(guess.w, who, "guess.w");
@@ -253,9 +278,9 @@ inline distributed_hopf_result solve_hopf(distributed_aerofoil& d, const distrib
   }
 
   // normalisation: s = e_k at the largest |p_k| over the ranks, p scaled to p_k = i
-  vec<C> p = guess.p;
-  vec<double> s = vec<double>::Zero(n);
-  {
+  vec<double> s(n);
+  auto normalise = [&](vec<C>& p) {
+    s.setZero();
     struct {
       double value;
       int rank;
@@ -271,7 +296,9 @@ inline distributed_hopf_result solve_hopf(distributed_aerofoil& d, const distrib
       s[k] = 1.0;
       p[k] = C(0.0, 1.0);
     }
-  }
+  };
+  vec<C> p = guess.p;
+  normalise(p);
 
   // the iterate
   vec<double> w = guess.w, pr = p.real(), pi = p.imag();
@@ -342,6 +369,65 @@ inline distributed_hopf_result solve_hopf(distributed_aerofoil& d, const distrib
   assemble();
   vec<double> f = residual();
   double fn = norm(f);
+  if (fixed && opt.start_iterations > 0 && fn > opt.start_residual_threshold) {
+    const auto t0 = aerohopf::internal::hopf_clock::now();
+    precondition();
+    const distributed_aerofoil_operator op(d, a, C(0.0, om));
+    krylov_options ko = opt.krylov;
+    ko.relative_tolerance = opt.start_tolerance;
+    ko.max_iterations = std::min(ko.max_iterations, opt.start_max_iterations);
+    ko.throw_on_failure = false;
+    ko.context = label + ": start refinement";
+    auto global_norm = [&](const vec<C>& v) {
+      double q = v.allFinite() ? v.squaredNorm() : NAN;
+      d.sum(&q, 1);
+      return std::sqrt(q);
+    };
+    vec<C> v(n), y(n);
+    v.real() = pr;
+    v.imag() = pi;
+    long its = 0;
+    bool ok = true;
+    for (int k = 0; k < opt.start_iterations && ok; ++k) {
+      v /= global_norm(v);
+      y.setZero();
+      its += gmres<C>(op, pc, v, y, ko).iterations;
+      const double ny = global_norm(y);
+      ok = std::isfinite(ny) && ny > 0;
+      if (ok) v = y / ny;
+    }
+    res.linear_iterations += its;
+    res.linear_seconds += aerohopf::internal::seconds_since(t0);
+    if (ok) {
+      // the Rayleigh quotient v^H J v / v^H v (local products: every unknown counted once)
+      std::array<C, 2> q{v.dot(d.multiply(a, v)), C(v.squaredNorm())};
+      d.sum(q.data(), 2);
+      const C lambda = q[0] / q[1];
+      const vec<double> pr0 = pr, pi0 = pi, s0 = s;
+      const double om0 = om;
+      normalise(v);
+      pr = v.real();
+      pi = v.imag();
+      if (lambda.imag() * om > 0) om = lambda.imag();
+      const vec<double> f1 = residual();
+      const double fn1 = norm(f1);
+      const bool kept = std::isfinite(fn1) && fn1 < fn;
+      if (ho.verbose && ho.log && root)
+        *ho.log << label << " start: " << opt.start_iterations << " inverse iteration(s), " << its
+                << " GMRES iterations, ||F|| " << std::scientific << std::setprecision(3) << fn << " -> " << fn1
+                << std::defaultfloat << (kept ? " (kept)" : " (discarded)") << ", omega " << om << "\n";
+      res.start_refined = kept;
+      if (kept) {
+        f = f1;
+        fn = fn1;
+      } else {
+        pr = pr0;
+        pi = pi0;
+        s = s0;
+        om = om0;
+      }
+    }
+  }
   const double f0 = fn, target = no.abs_tolerance + no.rel_tolerance * f0;
   rep.residual_history.push_back(fn);
   double last = fn;
@@ -359,6 +445,12 @@ inline distributed_hopf_result solve_hopf(distributed_aerofoil& d, const distrib
     }
     if (fn > no.divergence_factor * f0) {
       fail(aerohopf::internal::concat("diverged (||F|| > ", no.divergence_factor, " ||F_0||)"), k, fn);
+      break;
+    }
+    if (k >= no.contraction_from && fn > no.max_contraction * last) {
+      fail(aerohopf::internal::concat("not contracting at iterate ", k, ": ||F|| = ", fn, " from ", last, " (ratio ",
+                                      fn / last, " > max_contraction ", no.max_contraction, ")"),
+           k, fn);
       break;
     }
     if (k >= no.max_iterations) {
