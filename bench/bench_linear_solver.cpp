@@ -1,7 +1,10 @@
 // Benchmark of the dedicated linear solver (spec 07): SpMV, BILU(k) phases, complete solves of
 // CFD-like block systems in the complex (A - i omega I) and real 2n forms, against a STREAM
 // triad measured in the same binary, Eigen's IncompleteLUT + BiCGSTAB / GMRES and (if CMake
-// found it) PETSc SeqBAIJ ILU(k) + GMRES.
+// found it) PETSc SeqBAIJ ILU(k) + GMRES: in this build PETSc's real build on the real 2n form;
+// in bench_linear_solver_petsc_complex (the same source, where Debian's complex build is
+// installed: libpetsc-complex-dev) PETSc's complex build on the complex A - i omega I matrices
+// themselves, the like-for-like peer of our complex form.
 //
 // WHY: the Hopf and centre-manifold solves are dominated by these linear solves; the kernels are
 // memory-bound, so their bandwidth is compared with what the machine can stream at all.
@@ -37,6 +40,7 @@
 #include <map>
 #include <memory>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 #include "cfd_jacobian.hpp"
@@ -375,14 +379,30 @@ void bench_eigen(benchmark::State& state, std::function<problem<B>&()> get, form
 }
 
 #ifdef AEROHOPF_HAVE_PETSC
+// The scalar of the PETSc build linked: complex (Debian's libpetsc-complex-dev, the target
+// bench_linear_solver_petsc_complex) solves A - i omega I itself, the matrices of our complex
+// form; real solves the real 2n form.
+#if defined(PETSC_USE_COMPLEX)
+using petsc_value = cd;
+constexpr form petsc_form = form::complex;
+#else
+using petsc_value = double;
+constexpr form petsc_form = form::real2n;
+#endif
+static_assert(sizeof(PetscScalar) == sizeof(petsc_value), "PETSc's scalar is not the expected one");
+
 // PETSc SeqBAIJ (block size B) ILU(k) + right-preconditioned GMRES(60), unpreconditioned norm.
 template <int B>
 void bench_petsc(benchmark::State& state, std::function<problem<B>&()> get, form f, int fill, double rtol) {
   auto& p = get();
-  const auto& m = pick<B, double>(p, f);
+  const auto& m = pick<B, petsc_value>(p, f);
   vec<cd> bc(p.a.rows());
   for (Eigen::Index i = 0; i < bc.size(); ++i) bc(i) = cd(std::sin(0.001 * i) + 1.0, std::cos(0.0007 * i));
-  const vec<double> b = f == form::real2n ? real_form_vector(bc, B, real_form_ordering::interleaved) : vec<double>(bc.real());
+  vec<petsc_value> b;
+  if constexpr (std::is_same_v<petsc_value, cd>) b = bc;
+  else b = f == form::real2n ? real_form_vector(bc, B, real_form_ordering::interleaved) : vec<double>(bc.real());
+  // the same layout (std::complex<double> is two doubles, as PETSc's complex scalar)
+  auto petsc = [](const petsc_value* x) { return reinterpret_cast<const PetscScalar*>(x); };
   for (auto _ : state) {
     // The conversion to PETSc's own matrix (SeqBAIJ assembly) is timed separately
     // (assembly_seconds) and NOT counted in setup or total: only PETSc's solver is compared.
@@ -396,17 +416,17 @@ void bench_petsc(benchmark::State& state, std::function<problem<B>&()> get, form
     std::vector<PetscInt> cols;
     for (PetscInt i = 0; i < nb; ++i) {
       cols.assign(m.col_index().begin() + m.row_ptr()[i], m.col_index().begin() + m.row_ptr()[i + 1]);
-      MatSetValuesBlocked(a, 1, &i, PetscInt(cols.size()), cols.data(), m.values().data() + std::size_t(m.row_ptr()[i]) * B * B,
-                          INSERT_VALUES);
+      MatSetValuesBlocked(a, 1, &i, PetscInt(cols.size()), cols.data(),
+                          petsc(m.values().data() + std::size_t(m.row_ptr()[i]) * B * B), INSERT_VALUES);
     }
     MatAssemblyBegin(a, MAT_FINAL_ASSEMBLY);
     MatAssemblyEnd(a, MAT_FINAL_ASSEMBLY);
     Vec pb, px;
     VecCreateSeq(PETSC_COMM_SELF, nb * B, &pb);
     VecDuplicate(pb, &px);
-    double* pv;
+    PetscScalar* pv;
     VecGetArray(pb, &pv);
-    std::copy(b.data(), b.data() + b.size(), pv);
+    std::copy(petsc(b.data()), petsc(b.data()) + b.size(), pv);
     VecRestoreArray(pb, &pv);
     const double t0 = now();
     KSP ksp;
@@ -553,7 +573,7 @@ void register_peers(const std::string& mname, std::function<problem<B>&()> get, 
           ->Iterations(1);
     }
 #ifdef AEROHOPF_HAVE_PETSC
-    if (f != form::complex)
+    if (f == petsc_form)
       for (int k : petsc_fills)
         benchmark::RegisterBenchmark(nm({"solve", mname, bs, form_name(f), "1", std::to_string(k),
                                          "petsc_baij_ilu_gmres60_" + tol_name(tol)})
