@@ -1,15 +1,18 @@
 // The flutter boundaries of the pitch-plunge NACA 0012 (as aerofoil_flutter's) with the heavy
 // solves on MPI ranks: the library driver trace_flutter_boundary over
 // distributed::aerofoil_family (distributed/mpi_aerofoil_family.hpp), whose steady flows,
-// inverse-power starts and Hopf points are solved on the ranks; the driver's decisions are the
-// same on every rank, rank 0 prints and writes. Zero incidence; 1 to 3 ranks (the C-grid's
-// blocks). Built where the distributed component exists (MPI found).
+// inverse-power starts and Hopf points are solved on the ranks (at --incidence the static
+// aeroelastic equilibria and full Hopf systems too); the driver's decisions are the same on every
+// rank, rank 0 prints and writes. 1 to 3 ranks (the C-grid's blocks). Built where the distributed
+// component exists (MPI found).
 //
 // Usage: mpirun -np N aerofoil_flutter_mpi [out_dir] [options]
 //   --case light|heavy|both  --grids coarse,medium  --mach-min M --mach-max M --mach-step d
-//   --skip-jump-check  --verbose      as aerofoil_flutter's (default: both cases, coarse and medium)
-// Outputs under out_dir (default out/aerofoil_flutter_mpi): boundary_<case>_<grid>.csv, the
-// serial example's format. Exit status 1 if a boundary is incomplete or a crossing check fails.
+//   --incidence DEG  --skip-jump-check  --verbose
+//                    as aerofoil_flutter's (default: both cases, coarse and medium, zero incidence)
+// Outputs under out_dir (default out/aerofoil_flutter_mpi): boundary_<case>_<grid>.csv (at an
+// incidence boundary_<case>_<grid>_alpha<DEG>.csv), the serial example's format. Exit status 1
+// if a boundary is incomplete or a crossing check fails.
 #include <mpi.h>
 
 #include <aerohopf/distributed/mpi_aerofoil_family.hpp>
@@ -17,6 +20,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
+#include <numbers>
 #include <string>
 
 #include "../common/cli.hpp"
@@ -28,17 +32,37 @@ using namespace aerofoil_example;
 
 namespace aerofoil_example {
 
+/// fn() on rank 0 only (output), its failure thrown on every rank (the others would otherwise
+/// wait in the next collective).
+template <class Fn>
+void on_root(Fn&& fn) {
+  int rank = 0;
+  MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+  int ok = 1;
+  std::string why;
+  if (rank == 0) {
+    try {
+      fn();
+    } catch (const std::exception& e) {
+      ok = 0;
+      why = e.what();
+    }
+  }
+  MPI_Bcast(&ok, 1, MPI_INT, 0, MPI_COMM_WORLD);
+  if (!ok) throw error(rank == 0 ? why : std::string("rank 0 failed to write its output"));
+}
+
 // the serial example's declaration (parts.hpp); here the boundary on the ranks
 flutter_boundary boundary_on(const options& o, const structural_case& c, const grid_level& g,
                              const flutter_boundary* coarser) {
   int rank = 0;
   MPI_Comm_rank(MPI_COMM_WORLD, &rank);
-  const distributed::aerofoil_family family(family_of(c), MPI_COMM_WORLD);
+  const distributed::aerofoil_family family(family_of(c, o.incidence_deg * std::numbers::pi / 180), MPI_COMM_WORLD);
   flutter_boundary_options fo = driver_options(o, c, g, family.serial());
   fo.label += " on " + std::to_string(family.ranks()) + " ranks";
   fo.log = rank == 0 ? &std::cout : nullptr;
   flutter_boundary b = trace_flutter_boundary(family, g.stride, mach_list(o), coarser, fo);
-  if (rank == 0) write_boundary(o, c, g, b);
+  on_root([&] { write_boundary(o, c, g, b); });
   return b;
 }
 
@@ -64,6 +88,10 @@ options parse(int argc, char** argv) {
     } else if (a == "--mach-step") {
       o.mach_step = args.number();
       require(o.mach_step > 0, "--mach-step must be > 0");
+    } else if (a == "--incidence") {
+      o.incidence_deg = args.number();
+      require(std::abs(o.incidence_deg) < 10, "--incidence: a mean angle of attack in degrees, |alpha| < 10 (got ",
+              o.incidence_deg, ")");
     } else if (a == "--skip-jump-check") {
       o.crossing_check = false;
     } else if (a == "--verbose") {
@@ -81,7 +109,7 @@ options parse(int argc, char** argv) {
 
 int run(int argc, char** argv, int rank) {
   const options o = parse(argc, argv);
-  if (rank == 0) std::filesystem::create_directories(o.out);
+  on_root([&] { std::filesystem::create_directories(o.out); });
   const auto t0 = clk::now();
   int failed = 0;
   for (const auto& c : o.cases) {

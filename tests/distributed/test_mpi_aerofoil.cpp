@@ -7,16 +7,20 @@
 // the structural part counts once in a sum over the ranks; also at the section at rest (the
 // rest grid); the eigenvalue of a structural mode by inverse power on the ranks equals the serial
 // sparse-LU inverse power's, and its root locus over Ubar the serial root_locus's; a bad local
-// size, a NaN entry or a NaN Ubar is refused on every rank.
+// size, a NaN entry or a NaN Ubar is refused on every rank; the static aeroelastic equilibrium at
+// a mean incidence by Newton-GMRES on the ranks equals the serial one.
 #include <gtest/gtest.h>
 #include <mpi.h>
 
 #include <aerohopf/bifurcation/inverse_power.hpp>
 #include <aerohopf/distributed/mpi_aerofoil.hpp>
 #include <aerohopf/distributed/mpi_steady.hpp>
+#include <aerohopf/flow/naca_cgrid.hpp>
+#include <aerohopf/models/aerofoil_family.hpp>
 
 #include <complex>
 #include <functional>
+#include <numbers>
 #include <vector>
 
 #include <iostream>
@@ -163,6 +167,41 @@ TEST(mpi_aerofoil, root_locus_equals_the_serial_one) {
   }
   // a NaN Ubar is refused before any point is computed, on every rank
   EXPECT_THROW(distributed::root_locus(d, [&](double) { return local; }, {3.0, NAN}, cd(0.13, 0.35), o), input_error);
+}
+
+// The static aeroelastic equilibrium at a mean incidence of 1 deg (very coarse NACA 0012, M = 0.5,
+// light case, Ubar = 1.7) by Newton-GMRES on the ranks from the loaded steady flow about the
+// section at rest, against the serial family's static_equilibrium (solve_equilibrium_krylov);
+// too few iterations: a result not converged with the reason on every rank.
+TEST(mpi_aerofoil, static_equilibrium_equals_the_serial_one) {
+  structure::pitch_plunge_parameters pp;
+  pp.mu_s = 10;
+  const models::aerofoil_family f(flow::naca_cgrid(), pp, {}, std::numbers::pi / 180);
+  const models::aerofoil_system sys = f.system(8, 0.5);
+  const vec<double> ref = f.static_equilibrium(sys, 1.7);
+  const vec<double> rest = sys.steady_equilibrium({}, INFINITY);  // the flow loads the section
+  distributed_aerofoil d(sys, partition_blocks(sys.flow(), world_size()), MPI_COMM_WORLD);
+  const distributed_equilibrium_result r = solve_equilibrium(d, d.local_part(rest), 1.7);
+  ASSERT_TRUE(r.converged) << r.reason;
+  EXPECT_LE(r.residual, 1e-10);
+  const vec<double> w = d.all_gather(r.w);
+  EXPECT_LT((w - ref).norm(), 1e-8 * ref.norm());
+  const double pitch = w[w.size() - 2];
+  EXPECT_GT(pitch, 1e-4);  // a nose-up static deflection
+  EXPECT_NEAR(pitch, ref[ref.size() - 2], 1e-9);
+  EXPECT_GT(r.linear_iterations, 0);
+  if (d.rank() == 0)
+    std::cout << world_size() << " ranks: static pitch " << pitch << " rad (serial " << ref[ref.size() - 2] << "), "
+              << r.iterations << " Newton, " << r.linear_iterations << " GMRES\n";
+  distributed_equilibrium_options one;
+  one.max_iterations = 1;
+  const distributed_equilibrium_result q = solve_equilibrium(d, d.local_part(rest), 1.7, one);
+  EXPECT_FALSE(q.converged);
+  EXPECT_TRUE(test::contains(q.reason, "no convergence in 1 Newton iterations")) << q.reason;
+  EXPECT_EQ(q.iterations, 1);
+  one.fill_level = -1;
+  EXPECT_TRUE(test::contains(test::input_error_of([&] { (void)solve_equilibrium(d, d.local_part(rest), 1.7, one); }),
+                             "fill_level"));
 }
 
 TEST(mpi_aerofoil, bad_input_is_refused_on_every_rank) {

@@ -332,6 +332,21 @@ class distributed_aerofoil_operator {
   std::complex<double> sigma_;
 };
 
+/// J on real vectors of the ranks (the static equilibrium's and the full Hopf flow update's
+/// operator), J the Jacobian rows j.
+class real_aerofoil_operator {
+ public:
+  real_aerofoil_operator(distributed_aerofoil& d, const distributed_aerofoil::jacobian_rows& j) : d_(&d), j_(&j) {}
+  Eigen::Index rows() const { return d_->local_size(); }
+  Eigen::Index cols() const { return d_->local_size(); }
+  void apply(const vec<double>& x, vec<double>& y) const { y = d_->multiply(*j_, x); }
+  void global_sum(double* p, int n) const { d_->sum(p, n); }
+
+ private:
+  distributed_aerofoil* d_;
+  const distributed_aerofoil::jacobian_rows* j_;
+};
+
 /// Block-Jacobi preconditioner of P - sigma I for a distributed_aerofoil (P: the Jacobian rows
 /// of the preconditioning matrix, the modified-order one): complex BILU(k) M of each rank's own
 /// part of A_ff - sigma I, and the border eliminated exactly around it. With Y = M^{-1} A_fs
@@ -452,6 +467,107 @@ inline eigen_pair inverse_power(distributed_aerofoil& d, const distributed_aerof
       comm, start, d.flow().model().size() + distributed_aerofoil::ns,
       [&d](const vec<double>& g) { return d.local_part(g); }, [&](const vec<C>& v) { return d.multiply(a, v); }, op,
       pc, shift, a_norm, opt, who);
+}
+
+struct distributed_equilibrium_options {
+  int fill_level = 2;           ///< k of the real block-Jacobi BILU(k) of the modified-order rows
+  double tolerance = 1e-10;     ///< ||f(w, Ubar)||_2 over the ranks
+  int max_iterations = 25;      ///< full Newton steps
+  double eta_max = 1e-2;        ///< GMRES forcing eta_k = min(eta_max, max(||f_k||, 0.1 tolerance / ||f_k||))
+  krylov_options krylov = [] {
+    krylov_options o;
+    o.max_iterations = 2000;
+    o.restart = 80;
+    o.record_history = false;
+    return o;
+  }();
+};
+
+struct distributed_equilibrium_result {
+  vec<double> w;            ///< this rank's part of the last iterate (the equilibrium if converged)
+  bool converged = false;
+  int iterations = 0;
+  long linear_iterations = 0;
+  double residual = NAN;    ///< ||f|| of w
+  std::string reason;       ///< why not converged (the same text on every rank)
+};
+
+/// The static aeroelastic equilibrium f(w, Ubar) = 0 on the ranks (as solve_equilibrium_krylov
+/// for the serial system with full steps): Newton from w0 (this rank's part), each step by GMRES
+/// on the exact Jacobian rows preconditioned by the real block-Jacobi BILU(k) of the
+/// modified-order rows with the structure eliminated exactly, the inexact forcing of the
+/// options. Converged when ||f||_2 <= tolerance; a non-finite residual, a GMRES failure, a
+/// breakdown or the iteration limit is a result with converged = false and the reason, the
+/// same on every rank (the last finite iterate in w). Collective.
+inline distributed_equilibrium_result solve_equilibrium(distributed_aerofoil& d, vec<double> w0, double ubar,
+                                                        const distributed_equilibrium_options& opt = {}) {
+  const char* who = "distributed solve_equilibrium (aeroelastic)";
+  internal::collective(d.communicator(), who, [&] {
+    validate_krylov_options(opt.krylov, who);
+    require(opt.fill_level >= 0 && opt.fill_level <= 8, who, ": fill_level must lie in [0, 8] (got ", opt.fill_level,
+            ")");
+    require(opt.tolerance > 0 && std::isfinite(opt.tolerance), who, ": tolerance must be finite and > 0");
+    require(opt.max_iterations >= 1, who, ": max_iterations must be >= 1");
+    require(opt.eta_max > 0 && opt.eta_max < 1, who, ": eta_max must lie in (0, 1)");
+  });
+  d.check_state(w0, ubar, who);
+  distributed_equilibrium_result r;
+  r.w = std::move(w0);
+  auto norm = [&d](const vec<double>& f) {
+    double q = f.allFinite() ? f.squaredNorm() : NAN;
+    d.sum(&q, 1);
+    return std::sqrt(q);
+  };
+  block_ilu_options io;
+  io.fill_level = opt.fill_level;
+  io.context = aerohopf::internal::concat(who, ": block-Jacobi BILU(", opt.fill_level, ") of L");
+  basic_distributed_aerofoil_preconditioner<double> pc(io);
+  distributed_aerofoil::jacobian_rows a, l;
+  vec<double> f = d.residual(r.w, ubar);
+  r.residual = norm(f);
+  for (int k = 0;; ++k) {
+    if (!std::isfinite(r.residual)) {
+      r.reason = aerohopf::internal::concat(who, ": the residual is not finite at iterate ", k, " (Ubar = ", ubar, ")");
+      return r;
+    }
+    if (r.residual <= opt.tolerance) {
+      r.converged = true;
+      return r;
+    }
+    if (k >= opt.max_iterations) {
+      r.reason = aerohopf::internal::concat(who, ": no convergence in ", opt.max_iterations,
+                                            " Newton iterations (||f|| = ", r.residual, ", Ubar = ", ubar, ")");
+      return r;
+    }
+    try {
+      d.jacobians(r.w, ubar, a, l);
+      pc.compute(d, l, 0.0);
+      const real_aerofoil_operator op(d, a);
+      krylov_options ko = opt.krylov;
+      ko.relative_tolerance = std::min(opt.eta_max, std::max(r.residual, 0.1 * opt.tolerance / r.residual));
+      ko.throw_on_failure = true;
+      ko.context = aerohopf::internal::concat(who, ": GMRES, Newton step ", k + 1);
+      vec<double> dw = vec<double>::Zero(r.w.size());
+      r.linear_iterations += gmres<double>(op, pc, vec<double>(-f), dw, ko).iterations;
+      vec<double> w = r.w + dw;
+      const vec<double> fw = d.residual(w, ubar);
+      const double fn = norm(fw);
+      r.iterations = k + 1;
+      if (!std::isfinite(fn)) {
+        r.reason = aerohopf::internal::concat(who, ": the residual is not finite after Newton step ", k + 1,
+                                              " (Ubar = ", ubar, ")");
+        return r;
+      }
+      r.w = std::move(w);
+      f = fw;
+      r.residual = fn;
+    } catch (const input_error&) {
+      throw;
+    } catch (const error& e) {
+      r.reason = aerohopf::internal::concat(who, ": Newton step ", k + 1, ": ", e.what());
+      return r;
+    }
+  }
 }
 
 /// The root locus (bifurcation/root_locus.hpp, the same loop) on the ranks: equilibrium(Ubar)

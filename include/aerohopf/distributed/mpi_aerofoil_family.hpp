@@ -3,24 +3,24 @@
 // on the ranks of an MPI communicator, so that trace_flutter_boundary (run alike on every rank)
 // computes the serial boundary with the work split:
 //  * equilibrium: the steady flow about the section at rest by flow::solve_steady on the ranks
-//    (distributed_euler_discretisation, block-Jacobi BILU), gathered, its loads checked as
-//    aerofoil_system::steady_equilibrium does;
+//    (distributed_euler_discretisation, block-Jacobi BILU), gathered; at zero incidence its loads
+//    are checked as aerofoil_system::steady_equilibrium does; at a mean incidence the static
+//    aeroelastic equilibrium is continued from it in Ubar by distributed::solve_equilibrium
+//    (Newton-GMRES on the coupled rows), as the serial family does with solve_equilibrium_krylov;
 //  * hopf_start: distributed::inverse_power at (w, Ubar), shift i omega (the driver's
 //    hopf_start_krylov options: BILU fill, GMRES restart and tolerance, eigen-residual target);
-//  * solve_hopf: distributed::solve_hopf (fixed equilibrium) with the driver's Newton options,
-//    BILU fill, GMRES restart and forcing bound.
+//  * solve_hopf: distributed::solve_hopf in the driver's formulation (fixed equilibrium, or the
+//    full system at an incidence) with its Newton options, BILU fill, GMRES restart, forcing bound
+//    and start refinement.
 // Vectors cross this interface whole: each rank's part of a result is all-gathered, so the
-// driver's predictions, mode test, tracer hand-over and crossing check run on every rank on the
-// same numbers and every rank takes the same decisions (the reductions are MPI_Allreduce: the
-// same bits everywhere). The grid and the systems are replicated (about 0.55 kB a cell: fine for
-// the aerofoil; a wing wants a per-rank grid).
+// driver's predictions, mode test, tracer hand-over and crossing check (and, at an incidence,
+// its V-g scans) run on every rank on the same numbers and every rank takes the same decisions
+// (the reductions are MPI_Allreduce: the same bits everywhere). The grid and the systems are
+// replicated (about 0.55 kB a cell: fine for the aerofoil; a wing wants a per-rank grid).
 // Each level's C-grid is partitioned by whole blocks (partition_blocks: 3 blocks, so 1 to 3
 // ranks), the same cells as the serial numbering, so the boundary equals the serial one to the
 // solvers' tolerances; only the preconditioner (block Jacobi across the ranks) and hence the
-// linear iterations differ; the serial solve_hopf_krylov's start refinement
-// (hopf_krylov_options::start_iterations, threshold and tolerance) is done on the ranks alike.
-// Zero incidence only: the static aeroelastic equilibrium of a mean incidence (the full
-// formulation's moving equilibrium) is not yet solved on the ranks, so such a family is refused.
+// linear iterations differ.
 #include <mpi.h>
 
 #include <aerohopf/bifurcation/flutter_boundary.hpp>
@@ -44,24 +44,62 @@ class aerofoil_family {
   using system_type = models::aerofoil_system;
   static constexpr int block_size = models::aerofoil_family::block_size;
 
-  /// serial: the family (the same on every rank, zero incidence); comm: its ranks (1 to 3, the
-  /// C-grid's blocks). Collective: every rank must construct it.
+  /// serial: the family (the same on every rank); comm: its ranks (1 to 3, the C-grid's blocks).
+  /// Collective: every rank must construct it.
   aerofoil_family(models::aerofoil_family serial, MPI_Comm comm) : serial_(std::move(serial)), comm_(comm) {
     internal::check_mpi(MPI_Comm_size(comm_, &ranks_), "MPI_Comm_size");
     internal::check_mpi(MPI_Comm_rank(comm_, &rank_), "MPI_Comm_rank");
-    require(serial_.alpha() == 0.0, "distributed::aerofoil_family: angle of attack ", serial_.alpha(),
-            " rad: the static aeroelastic equilibrium of a mean incidence is not solved on the ranks (zero incidence "
-            "only)");
   }
 
   system_type system(int stride, double mach) const { return serial_.system(stride, mach); }
   static std::string level_name(int stride) { return models::aerofoil_family::level_name(stride); }
-  bool fixed_equilibrium() const { return true; }
+  bool fixed_equilibrium() const { return serial_.fixed_equilibrium(); }
 
-  /// The steady flow of s about the section at rest on the ranks (the same for every Ubar),
-  /// whole on every rank; convergence_error as aerofoil_system::steady_equilibrium (no
-  /// convergence, or loads on the section at rest).
-  vec<double> equilibrium(const system_type& s, double /*ubar*/) const {
+  /// The equilibrium of s at Ubar on the ranks, whole on every rank: at zero incidence the steady
+  /// flow about the section at rest (the same for every Ubar; convergence_error as
+  /// aerofoil_system::steady_equilibrium if it does not converge or loads the section); at an
+  /// incidence the static aeroelastic equilibrium continued from it (static_equilibrium_from).
+  vec<double> equilibrium(const system_type& s, double ubar) const {
+    const bool at_rest = serial_.alpha() == 0.0;
+    vec<double> w = steady_flow(s, at_rest);
+    if (at_rest) return w;
+    return static_equilibrium_from(s, w, 0.0, ubar);
+  }
+
+  /// The equilibrium at ubar from w0, the one at u0: w0 itself at zero incidence, else
+  /// static_equilibrium_from.
+  vec<double> equilibrium_from(const system_type& s, const vec<double>& w0, double u0, double ubar) const {
+    if (serial_.alpha() == 0.0) return serial_.equilibrium_from(s, w0, u0, ubar);
+    return static_equilibrium_from(s, w0, u0, ubar);
+  }
+
+  /// The static aeroelastic equilibrium at ubar from w0 (whole; the one at u0, 0: the section at
+  /// rest) on the ranks: distributed::solve_equilibrium (BILU(2), ||f|| <= 1e-10, full Newton
+  /// steps) in the serial family's continuation in Ubar (models::aerofoil_family::continue_in_ubar:
+  /// a failed step halved down to 1/64 of |Ubar|, then convergence_error). Whole on every rank.
+  vec<double> static_equilibrium_from(const system_type& s, const vec<double>& w0, double u0, double ubar) const {
+    require(std::isfinite(ubar) && ubar != 0.0 && std::isfinite(u0),
+            "distributed::aerofoil_family::static_equilibrium_from: Ubar = ", ubar, " from ", u0);
+    require_size(w0.size(), s.size(), "distributed::aerofoil_family::static_equilibrium_from", "start state");
+    distributed_aerofoil d(s, partition_blocks(s.flow(), ranks_), comm_);
+    const std::string who = aerohopf::internal::concat("distributed::aerofoil_family::static_equilibrium at M = ",
+                                                       s.flow().conditions().mach, ", Ubar = ", ubar, " on ", ranks_,
+                                                       " ranks");
+    const vec<double> w = models::aerofoil_family::continue_in_ubar(
+        d.local_part(w0), u0, ubar, who,
+        [&](const vec<double>& wl, double u, std::string& why) -> std::optional<vec<double>> {
+          auto r = solve_equilibrium(d, wl, u);
+          if (r.converged) return std::move(r.w);
+          why = r.reason;
+          return std::nullopt;
+        });
+    return d.all_gather(w);
+  }
+
+  /// The steady flow of s about the section at rest on the ranks, whole on every rank, the
+  /// structure at rest; check_loads: convergence_error if it loads the section (|C_l| or |C_m| >
+  /// max_load: then it is no equilibrium of the coupled system).
+  vec<double> steady_flow(const system_type& s, bool check_loads) const {
     flow::euler_model<2> m = s.flow();
     distributed_euler<2> d(m, partition_blocks(m, ranks_), comm_);
     distributed_euler_discretisation<2> disc(m, d);
@@ -70,21 +108,17 @@ class aerofoil_family {
     const double mach = s.flow().conditions().mach;
     if (!r.converged)
       throw convergence_error(aerohopf::internal::concat(
-          "distributed::aerofoil_family::equilibrium: the steady flow at M = ", mach, " on ", ranks_,
-          " ranks did not converge (", r.steps, " steps, residual ", r.final_residual, ": ", r.reason, ")"));
+          "distributed::aerofoil_family: the steady flow at M = ", mach, " on ", ranks_, " ranks did not converge (",
+          r.steps, " steps, residual ", r.final_residual, ": ", r.reason, ")"));
     vec<double> w = s.free_stream_state();
     w.head(s.flow_size()) = d.all_gather(wf);
+    if (!check_loads) return w;
     const auto [cl, cm] = s.load_coefficients<double>(w);
     if (!(std::abs(cl) <= max_load && std::abs(cm) <= max_load))
       throw convergence_error(aerohopf::internal::concat(
-          "distributed::aerofoil_family::equilibrium: the steady flow at M = ", mach, " loads the section at rest (C_l = ",
-          cl, ", C_m = ", cm, ", limit ", max_load, "): not an equilibrium of the coupled system"));
+          "distributed::aerofoil_family: the steady flow at M = ", mach, " loads the section at rest (C_l = ", cl,
+          ", C_m = ", cm, ", limit ", max_load, "): not an equilibrium of the coupled system"));
     return w;
-  }
-
-  /// w0 itself: at zero incidence the equilibrium does not depend on Ubar.
-  vec<double> equilibrium_from(const system_type& s, const vec<double>& w0, double u0, double ubar) const {
-    return serial_.equilibrium_from(s, w0, u0, ubar);
   }
 
   /// The eigenpair of J(w, Ubar) nearest i omega by inverse power on the ranks, as a Hopf start
@@ -108,12 +142,10 @@ class aerofoil_family {
     return aerohopf::internal::hopf_point_from(w, ubar, ep);
   }
 
-  /// The Hopf point from `guess` on the ranks (fixed-equilibrium formulation), whole on every
-  /// rank; failures as distributed::solve_hopf (convergence_error on every rank).
+  /// The Hopf point from `guess` on the ranks in the formulation of ho.fixed_equilibrium, whole
+  /// on every rank; failures as distributed::solve_hopf (convergence_error on every rank).
   hopf_result solve_hopf(const system_type& s, const hopf_point& guess, const hopf_options& ho,
                          const hopf_krylov_options& ko) const {
-    require(ho.fixed_equilibrium && !ko.full_system,
-            "distributed::aerofoil_family::solve_hopf: the fixed-equilibrium formulation only (zero incidence)");
     distributed_aerofoil d(s, partition_blocks(s.flow(), ranks_), comm_);
     distributed_hopf_options o;
     o.hopf = ho;
@@ -128,7 +160,7 @@ class aerofoil_family {
     distributed_hopf_point g{d.local_part(guess.w), guess.mu, guess.omega, d.local_part(guess.p)};
     const distributed_hopf_result r = distributed::solve_hopf(d, g, o);
     hopf_result h;
-    h.point.w = guess.w;  // the fixed equilibrium, unchanged
+    h.point.w = ho.fixed_equilibrium ? guess.w : d.all_gather(r.point.w);  // fixed: unchanged
     h.point.mu = r.point.mu;
     h.point.omega = r.point.omega;
     h.point.p = d.all_gather(r.point.p);

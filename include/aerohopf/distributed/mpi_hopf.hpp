@@ -216,20 +216,6 @@ class hopf_bordered_preconditioner {
   Eigen::Matrix2d schur_inv_;
 };
 
-/// A on real vectors of the ranks (the flow update's operator).
-class real_aerofoil_operator {
- public:
-  real_aerofoil_operator(distributed_aerofoil& d, const distributed_aerofoil::jacobian_rows& j) : d_(&d), j_(&j) {}
-  Eigen::Index rows() const { return d_->local_size(); }
-  Eigen::Index cols() const { return d_->local_size(); }
-  void apply(const vec<double>& x, vec<double>& y) const { y = d_->multiply(*j_, x); }
-  void global_sum(double* p, int n) const { d_->sum(p, n); }
-
- private:
-  distributed_aerofoil* d_;
-  const distributed_aerofoil::jacobian_rows* j_;
-};
-
 }  // namespace internal
 
 /// Newton on the Hopf system of a distributed_aerofoil from `guess` (file comment), the
@@ -478,7 +464,7 @@ inline distributed_hopf_result solve_hopf(distributed_aerofoil& d, const distrib
       vec<double> rhs = -f.tail(2 * n + 2);
       vec<double> dw0, dw1;
       if (!fixed) {
-        const internal::real_aerofoil_operator aop(d, a);
+        const real_aerofoil_operator aop(d, a);
         const auto t0 = aerohopf::internal::hopf_clock::now();
         dw0 = vec<double>::Zero(n);
         dw1 = vec<double>::Zero(n);

@@ -88,24 +88,39 @@ class aerofoil_family {
     eo.newton.max_iterations = 25;
     eo.newton.throw_on_failure = false;
     eo.newton.line_search = false;
-    const double a = std::abs(ubar);
-    double u = std::abs(u0), step = a - u;  // signed: towards a
-    vec<double> w = std::move(w0);
     const std::string who =
         internal::concat("aerofoil_family::static_equilibrium at M = ", s.flow().conditions().mach, ", Ubar = ", ubar);
+    return continue_in_ubar(std::move(w0), u0, ubar, who,
+                            [&](const vec<double>& w, double u, std::string& why) -> std::optional<vec<double>> {
+                              auto r = solve_equilibrium_krylov<block_size>(s, u, w, eo, who);
+                              if (r.report.converged) return std::move(r.w);
+                              why = r.report.reason;
+                              return std::nullopt;
+                            });
+  }
+
+  /// The continuation of static_equilibrium_from, for any solver of the static equilibrium:
+  /// from w, the equilibrium at u0, to ubar in steps of |Ubar| (doubled after a success);
+  /// solve(w, u, why) returns the equilibrium at |Ubar| = u from w, or nothing with the reason in
+  /// why; a failed step is retried from half of it, down to 1/64 of |Ubar|, then
+  /// convergence_error (who, the Ubar tried and reached, the reason).
+  template <class Solve>
+  static vec<double> continue_in_ubar(vec<double> w, double u0, double ubar, const std::string& who, Solve&& solve) {
+    const double a = std::abs(ubar);
+    double u = std::abs(u0), step = a - u;  // signed: towards a
     while (u != a) {
       const double next = std::abs(a - u) <= std::abs(step) ? a : u + step;
-      auto r = solve_equilibrium_krylov<block_size>(s, next, w, eo, who);
-      if (r.report.converged) {
-        w = std::move(r.w);
+      std::string why;
+      if (auto r = solve(w, next, why)) {
+        w = std::move(*r);
         u = next;
         step *= 2;
         continue;
       }
       step *= 0.5;
       if (std::abs(step) < a / 64)
-        throw convergence_error(internal::concat(who, ": Newton-Krylov failed at Ubar = ", next, " from Ubar = ", u,
-                                                 " (", r.report.reason, ")"));
+        throw convergence_error(
+            internal::concat(who, ": Newton-Krylov failed at Ubar = ", next, " from Ubar = ", u, " (", why, ")"));
     }
     return w;
   }
