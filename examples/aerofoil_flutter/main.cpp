@@ -144,40 +144,14 @@ void cost_part(const options& o, const boundaries& all, const std::vector<double
   }
 }
 
-std::vector<grid_level> grid_list(const std::string& v) {
-  std::vector<grid_level> g;
-  std::size_t a = 0;
-  while (a <= v.size()) {
-    const std::size_t e = v.find(',', a);
-    g.push_back(level_named(v.substr(a, e == std::string::npos ? std::string::npos : e - a)));
-    if (e == std::string::npos) break;
-    a = e + 1;
-  }
-  return g;
-}
-
 options parse(int argc, char** argv) {
   options o;
   example_cli::arguments args(argc, argv);
   for (std::string a; args.next(a);) {
     auto next = [&] { return args.value(); };
     auto number = [&] { return args.number(); };
-    if (a == "--case") {
-      const std::string v = next();
-      o.cases = v == "both" ? std::vector<structural_case>{light_case, heavy_case} : std::vector{case_named(v)};
-    } else if (a == "--grids") {
-      o.grids = grid_list(next());
-    } else if (a == "--mach-min") {
-      o.mach_min = number();
-    } else if (a == "--mach-max") {
-      o.mach_max = number();
-    } else if (a == "--mach-step") {
-      o.mach_step = number();
-      require(o.mach_step > 0, "--mach-step must be > 0");
-    } else if (a == "--incidence") {
-      o.incidence_deg = number();
-      require(std::abs(o.incidence_deg) < 10, "--incidence: a mean angle of attack in degrees, |alpha| < 10 (got ",
-              o.incidence_deg, ")");
+    if (read_boundary_option(a, args, o)) {
+      continue;
     } else if (a == "--contact-smoothing") {
       o.contact_smoothing = number();
       require(o.contact_smoothing >= 0, "--contact-smoothing must be >= 0");
@@ -218,18 +192,13 @@ options parse(int argc, char** argv) {
       require(o.vg_points >= 2, "--vg-points must be >= 2");
     } else if (a == "--crossing-medium") {
       o.crossing_medium = true;
-    } else if (a == "--verbose") {
-      o.verbose = true;
     } else if (a == "--quick") {
       o.quick = true;
-    } else if (!a.empty() && a[0] != '-') {
-      o.out = a;
     } else {
       throw input_error("unknown option " + a);
     }
   }
-  require(o.mach_min > 0 && o.mach_max >= o.mach_min && o.mach_max < 1, "need 0 < --mach-min <= --mach-max < 1 (got ",
-          o.mach_min, ", ", o.mach_max, ")");
+  check_mach_range(o);
   if (o.incidence_deg != 0.0 && (o.spectra || o.jump_check || o.verify || o.reduced)) {
     std::cout << "(--incidence: the spectra, dense jump check, time marching and reduced-model parts assume zero "
                  "incidence; skipped; the driver's crossing check is a V-g scan)\n";

@@ -75,35 +75,15 @@ options parse(int argc, char** argv) {
   o.out = "out/aerofoil_flutter_mpi";
   example_cli::arguments args(argc, argv);
   for (std::string a; args.next(a);) {
-    if (a == "--case") {
-      const std::string v = args.value();
-      o.cases = v == "both" ? std::vector<structural_case>{light_case, heavy_case} : std::vector{case_named(v)};
-    } else if (a == "--grids") {
-      o.grids.clear();
-      for (const auto& w : args.words()) o.grids.push_back(level_named(w));
-    } else if (a == "--mach-min") {
-      o.mach_min = args.number();
-    } else if (a == "--mach-max") {
-      o.mach_max = args.number();
-    } else if (a == "--mach-step") {
-      o.mach_step = args.number();
-      require(o.mach_step > 0, "--mach-step must be > 0");
-    } else if (a == "--incidence") {
-      o.incidence_deg = args.number();
-      require(std::abs(o.incidence_deg) < 10, "--incidence: a mean angle of attack in degrees, |alpha| < 10 (got ",
-              o.incidence_deg, ")");
+    if (read_boundary_option(a, args, o)) {
+      continue;
     } else if (a == "--skip-jump-check") {
       o.crossing_check = false;
-    } else if (a == "--verbose") {
-      o.verbose = true;
-    } else if (!a.empty() && a[0] != '-') {
-      o.out = a;
     } else {
       throw input_error("unknown option " + a);
     }
   }
-  require(o.mach_min > 0 && o.mach_max >= o.mach_min && o.mach_max < 1, "need 0 < --mach-min <= --mach-max < 1 (got ",
-          o.mach_min, ", ", o.mach_max, ")");
+  check_mach_range(o);
   return o;
 }
 

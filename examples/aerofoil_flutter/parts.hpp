@@ -33,6 +33,7 @@
 #include <string>
 #include <vector>
 
+#include "../common/cli.hpp"
 #include "setup.hpp"
 
 namespace aerofoil_example {
@@ -66,6 +67,43 @@ struct options {
 };
 
 using boundaries = std::map<std::string, flutter_boundary>;  // by "<case>_<grid>"
+
+/// The options both boundary programs read (aerofoil_flutter, aerofoil_flutter_mpi): --case,
+/// --grids, --mach-min, --mach-max, --mach-step, --incidence, --verbose and the output folder
+/// (a word without a leading '-'); true if `a` was one of them (its value read from args).
+inline bool read_boundary_option(const std::string& a, example_cli::arguments& args, options& o) {
+  if (a == "--case") {
+    const std::string v = args.value();
+    o.cases = v == "both" ? std::vector<structural_case>{light_case, heavy_case} : std::vector{case_named(v)};
+  } else if (a == "--grids") {
+    o.grids.clear();
+    for (const auto& w : args.words()) o.grids.push_back(level_named(w));
+  } else if (a == "--mach-min") {
+    o.mach_min = args.number();
+  } else if (a == "--mach-max") {
+    o.mach_max = args.number();
+  } else if (a == "--mach-step") {
+    o.mach_step = args.number();
+    require(o.mach_step > 0, "--mach-step must be > 0");
+  } else if (a == "--incidence") {
+    o.incidence_deg = args.number();
+    require(std::abs(o.incidence_deg) < 10, "--incidence: a mean angle of attack in degrees, |alpha| < 10 (got ",
+            o.incidence_deg, ")");
+  } else if (a == "--verbose") {
+    o.verbose = true;
+  } else if (!a.empty() && a[0] != '-') {
+    o.out = a;
+  } else {
+    return false;
+  }
+  return true;
+}
+
+/// The Mach range read: 0 < mach_min <= mach_max < 1.
+inline void check_mach_range(const options& o) {
+  require(o.mach_min > 0 && o.mach_max >= o.mach_min && o.mach_max < 1, "need 0 < --mach-min <= --mach-max < 1 (got ",
+          o.mach_min, ", ", o.mach_max, ")");
+}
 
 /// The listed Mach numbers: 0.50 .. 0.80 step 0.05, 0.81 .. 0.95 step 0.01 (spec 05), within
 /// [mach_min, mach_max]; or one uniform step.
