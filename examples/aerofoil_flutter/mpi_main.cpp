@@ -32,26 +32,6 @@ using namespace aerofoil_example;
 
 namespace aerofoil_example {
 
-/// fn() on rank 0 only (output), its failure thrown on every rank (the others would otherwise
-/// wait in the next collective).
-template <class Fn>
-void on_root(Fn&& fn) {
-  int rank = 0;
-  MPI_Comm_rank(MPI_COMM_WORLD, &rank);
-  int ok = 1;
-  std::string why;
-  if (rank == 0) {
-    try {
-      fn();
-    } catch (const std::exception& e) {
-      ok = 0;
-      why = e.what();
-    }
-  }
-  MPI_Bcast(&ok, 1, MPI_INT, 0, MPI_COMM_WORLD);
-  if (!ok) throw error(rank == 0 ? why : std::string("rank 0 failed to write its output"));
-}
-
 // the serial example's declaration (parts.hpp); here the boundary on the ranks
 flutter_boundary boundary_on(const options& o, const structural_case& c, const grid_level& g,
                              const flutter_boundary* coarser) {
@@ -62,7 +42,7 @@ flutter_boundary boundary_on(const options& o, const structural_case& c, const g
   fo.label += " on " + std::to_string(family.ranks()) + " ranks";
   fo.log = rank == 0 ? &std::cout : nullptr;
   flutter_boundary b = trace_flutter_boundary(family, g.stride, mach_list(o), coarser, fo);
-  on_root([&] { write_boundary(o, c, g, b); });
+  distributed::on_root(MPI_COMM_WORLD, "aerofoil_flutter_mpi output", [&] { write_boundary(o, c, g, b); });
   return b;
 }
 
@@ -89,7 +69,7 @@ options parse(int argc, char** argv) {
 
 int run(int argc, char** argv, int rank) {
   const options o = parse(argc, argv);
-  on_root([&] { std::filesystem::create_directories(o.out); });
+  distributed::on_root(MPI_COMM_WORLD, "aerofoil_flutter_mpi output", [&] { std::filesystem::create_directories(o.out); });
   const auto t0 = clk::now();
   int failed = 0;
   for (const auto& c : o.cases) {

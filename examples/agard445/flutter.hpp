@@ -15,6 +15,8 @@
 #include <aerohopf/time/eigenmode_march.hpp>
 #include <aerohopf/models/wing_family.hpp>
 #include <aerohopf/models/wing_vtk.hpp>
+#include <aerohopf/structure/plate_fe.hpp>
+#include <aerohopf/structure/wing_plate.hpp>
 
 #include <algorithm>
 #include <chrono>
@@ -22,9 +24,13 @@
 #include <complex>
 #include <cstdio>
 #include <filesystem>
+#include <functional>
+#include <iostream>
 #include <map>
 #include <string>
 #include <vector>
+
+#include "../common/cli.hpp"
 
 namespace agard445_flutter {
 
@@ -73,6 +79,85 @@ struct flutter_options {
   bool verbose = false;
 };
 
+/// The grid stride of a level name.
+inline int stride_of(const std::string& level) {
+  if (level == "very_coarse") return 8;
+  if (level == "coarse") return 4;
+  if (level == "medium") return 2;
+  if (level == "fine") return 1;
+  throw input_error("unknown grid level '" + level + "' (very_coarse, coarse, medium, fine)");
+}
+
+/// --mesh NI,NJ (the plate's chordwise x spanwise quads); false if `a` is another option.
+inline bool read_mesh_option(const std::string& a, example_cli::arguments& args, int& ni, int& nj) {
+  if (a != "--mesh") return false;
+  const std::string v = args.value();
+  const auto comma = v.find(',');
+  require(comma != std::string::npos, "--mesh takes NI,NJ (chordwise,spanwise quads), not ", v);
+  try {
+    ni = std::stoi(v.substr(0, comma));
+    nj = std::stoi(v.substr(comma + 1));
+  } catch (const std::exception&) {
+    throw input_error("--mesh takes two integers NI,NJ, not '" + v + "'");
+  }
+  require(ni >= 2 && nj >= 2 && ni <= 400 && nj <= 400, "--mesh: NI and NJ in [2, 400] (got ", ni, ",", nj, ")");
+  return true;
+}
+
+/// The boundary options both programs read (--flutter, --damping, --fine-damping, --machs,
+/// --verbose); false if `a` is another option.
+inline bool read_boundary_option(const std::string& a, example_cli::arguments& args, flutter_options& f) {
+  if (a == "--flutter") {
+    f.strides.clear();
+    for (const auto& l : args.words())
+      if (l != "none") f.strides.push_back(stride_of(l));
+    std::sort(f.strides.begin(), f.strides.end(), std::greater<>());
+  } else if (a == "--damping" || a == "--fine-damping") {
+    auto& list = a == "--damping" ? f.damping_percent : f.fine_damping_percent;
+    list = args.numbers();
+    for (double z : list) require(z >= 0 && z < 50, a, ": percentages in [0, 50) (got ", z, ")");
+  } else if (a == "--machs") {
+    f.machs = args.numbers();
+    for (std::size_t k = 0; k < f.machs.size(); ++k)
+      require(f.machs[k] > 0.3 && f.machs[k] < 1.3 && (k == 0 || f.machs[k] > f.machs[k - 1]),
+              "--machs: increasing Mach numbers in (0.3, 1.3)");
+  } else if (a == "--verbose") {
+    f.verbose = true;
+  } else {
+    return false;
+  }
+  return true;
+}
+
+/// The plate model's modes on an ni x nj mesh (count of them), with its mass and the time taken.
+struct solved {
+  structure::plate_mesh mesh;
+  structure::plate_modes modes;
+  double mass = 0, seconds = 0;
+};
+inline solved modes_on(const flow::wing_geometry& w, int ni, int nj, int count) {
+  const auto t0 = std::chrono::steady_clock::now();
+  solved s;
+  s.mesh = structure::wing_plate_mesh(w, ni, nj);
+  const structure::plate_matrices km = structure::assemble_plate(s.mesh, structure::agard445_6_mahogany(w.planform));
+  s.mass = structure::plate_mass(km);
+  structure::plate_mode_options mo;
+  mo.count = count;
+  s.modes = structure::plate_modes_of(km, structure::clamped_root(s.mesh, ni), mo);
+  s.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return s;
+}
+
+/// The first four modes of md: the flutter part's structure.
+inline structure::modal_data first_four(const structure::modal_data& md) {
+  require(md.modes() >= 4, "the flutter part needs four modes (--modes 4 or more)");
+  structure::modal_data four = md;
+  four.omega.conservativeResize(4);
+  four.generalised_mass.conservativeResize(4);
+  four.shapes.resize(4);
+  return four;
+}
+
 inline std::string damping_tag(double percent) {
   char b[32];
   std::snprintf(b, sizeof b, "zeta%g", percent);
@@ -100,17 +185,24 @@ struct boundary_run {
 };
 
 /// Every boundary of o (levels x dampings), written as boundary_<grid>_zeta<percent>.csv.
-inline std::vector<boundary_run> boundaries(const flutter_options& o, const std::filesystem::path& out,
-                                            const flow::wing_geometry& wing, const flow::wing_grid_options& grid,
-                                            const structure::modal_data& modes) {
+/// wrap(models::wing_family) gives the family the driver runs on (the serial one itself, or
+/// distributed::wing_family on MPI ranks); output(fn) runs the printing and writing fn (under
+/// MPI: on rank 0, its failure thrown on every rank: distributed::on_root); log: the driver's
+/// progress (nullptr on the other ranks). Every rank runs the driver alike.
+template <class Wrap, class Output>
+std::vector<boundary_run> boundaries(const flutter_options& o, const std::filesystem::path& out,
+                                     const flow::wing_geometry& wing, const flow::wing_grid_options& grid,
+                                     const structure::modal_data& modes, Wrap&& wrap, Output&& output,
+                                     std::ostream* log) {
   std::vector<boundary_run> runs;
   runs.reserve(o.strides.size() * o.damping_percent.size());  // `coarser` points into it
   const models::flutter_reference ref = agard_reference(wing.planform);
   std::vector<int> strides = o.strides;
   if (o.vg_stride) strides.push_back(o.vg_stride);
   for (double zeta : o.damping_percent) {
-    const models::wing_family family(wing, grid, strides, modes, Eigen::VectorXd::Constant(1, zeta / 100),
+    const models::wing_family serial(wing, grid, strides, modes, Eigen::VectorXd::Constant(1, zeta / 100),
                                      tunnel_schedule());
+    decltype(auto) family = wrap(serial);  // a reference to `serial` itself, or a new family
     const flutter_boundary* coarser = nullptr;
     for (int s : o.strides) {
       const bool finer = s != o.strides.front();
@@ -118,43 +210,48 @@ inline std::vector<boundary_run> boundaries(const flutter_options& o, const std:
                        o.fine_damping_percent.end())
         continue;
       const std::string name = models::wing_family::level_name(s);
-      std::printf("\n=== flutter boundary: %s grid, structural damping %g %%, %zu Mach numbers ===\n", name.c_str(), zeta,
-                  o.machs.size());
-      std::fflush(stdout);
+      output([&] {
+        std::printf("\n=== flutter boundary: %s grid, structural damping %g %%, %zu Mach numbers ===\n", name.c_str(),
+                    zeta, o.machs.size());
+        std::fflush(stdout);
+      });
       flutter_boundary_options fo = family.boundary_options();
-      std::tie(fo.start_mu, fo.start_omega) = experimental_start(family, o.machs.front());
-      fo.verbose = o.verbose;
+      std::tie(fo.start_mu, fo.start_omega) = experimental_start(serial, o.machs.front());
+      fo.verbose = o.verbose && log;
+      fo.log = log;
       fo.label = name + " " + damping_tag(zeta);
       const auto t0 = std::chrono::steady_clock::now();
       boundary_run r{s, zeta, trace_flutter_boundary(family, s, o.machs, coarser, fo), 0};
       r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-      csv_writer csv(out / ("boundary_" + name + "_" + damping_tag(zeta) + ".csv"),
-                     "mach,fsi,frequency_ratio,mass_ratio,q,omega,newton_iterations,linear_iterations,hopf_seconds,"
-                     "steady_seconds");
-      std::printf("  %6s %8s %8s %9s %9s %9s %9s %7s %7s | %8s %8s\n", "M", "FSI", "w/wa", "mass rat", "q Pa", "rho",
-                  "omega", "Hopf s", "steady", "exp FSI", "exp w/wa");
-      for (const auto& p : r.b.points) {
-        const models::flutter_numbers n = family.numbers(p.mach, p.mu, p.omega, ref);
-        csv.row({p.mach, n.fsi, n.frequency_ratio, n.mass_ratio, n.dynamic_pressure, p.omega,
-                 static_cast<long long>(p.newton_iterations), static_cast<long long>(p.linear_iterations),
-                 p.hopf_seconds, p.steady_seconds});
-        std::printf("  %6.3f %8.4f %8.4f %9.2f %9.1f %9.5f %9.5f %7.1f %7.1f", p.mach, n.fsi, n.frequency_ratio,
-                    n.mass_ratio, n.dynamic_pressure, n.density, p.omega, p.hopf_seconds, p.steady_seconds);
-        for (const auto& e : experiment())
-          if (std::abs(e.mach - p.mach) < 1e-9) std::printf(" | %8.4f %8.4f", e.fsi, e.frequency_ratio);
-        std::printf("\n");
-      }
-      if (!r.b.complete) std::printf("  boundary incomplete: %s\n", r.b.stop_reason.c_str());
-      for (const auto& p : r.b.points)  // the flutter mode at M = 0.96
-        if (std::abs(p.mach - 0.96) < 1e-9) {
-          models::write_flutter_mode_vtk(family.system(s, p.mach), p.point,
-                                         (out / ("flutter_mode_" + name + "_" + damping_tag(zeta) + "_M0.96")).string());
+      output([&] {
+        csv_writer csv(out / ("boundary_" + name + "_" + damping_tag(zeta) + ".csv"),
+                       "mach,fsi,frequency_ratio,mass_ratio,q,omega,newton_iterations,linear_iterations,hopf_seconds,"
+                       "steady_seconds");
+        std::printf("  %6s %8s %8s %9s %9s %9s %9s %7s %7s | %8s %8s\n", "M", "FSI", "w/wa", "mass rat", "q Pa", "rho",
+                    "omega", "Hopf s", "steady", "exp FSI", "exp w/wa");
+        for (const auto& p : r.b.points) {
+          const models::flutter_numbers n = serial.numbers(p.mach, p.mu, p.omega, ref);
+          csv.row({p.mach, n.fsi, n.frequency_ratio, n.mass_ratio, n.dynamic_pressure, p.omega,
+                   static_cast<long long>(p.newton_iterations), static_cast<long long>(p.linear_iterations),
+                   p.hopf_seconds, p.steady_seconds});
+          std::printf("  %6.3f %8.4f %8.4f %9.2f %9.1f %9.5f %9.5f %7.1f %7.1f", p.mach, n.fsi, n.frequency_ratio,
+                      n.mass_ratio, n.dynamic_pressure, n.density, p.omega, p.hopf_seconds, p.steady_seconds);
+          for (const auto& e : experiment())
+            if (std::abs(e.mach - p.mach) < 1e-9) std::printf(" | %8.4f %8.4f", e.fsi, e.frequency_ratio);
+          std::printf("\n");
         }
-      const flutter_boundary_costs c = boundary_costs(r.b, o.machs);
-      std::printf("  %zu points in %.1f s; Hopf work per steady solve %.2f (continued points), %.2f (all work beyond "
-                  "one steady solve per listed Mach number)\n",
-                  r.b.points.size(), r.seconds, c.hopf_per_steady, c.hopf_per_steady_listed);
-      std::fflush(stdout);
+        if (!r.b.complete) std::printf("  boundary incomplete: %s\n", r.b.stop_reason.c_str());
+        for (const auto& p : r.b.points)  // the flutter mode at M = 0.96
+          if (std::abs(p.mach - 0.96) < 1e-9) {
+            models::write_flutter_mode_vtk(serial.system(s, p.mach), p.point,
+                                           (out / ("flutter_mode_" + name + "_" + damping_tag(zeta) + "_M0.96")).string());
+          }
+        const flutter_boundary_costs c = boundary_costs(r.b, o.machs);
+        std::printf("  %zu points in %.1f s; Hopf work per steady solve %.2f (continued points), %.2f (all work beyond "
+                    "one steady solve per listed Mach number)\n",
+                    r.b.points.size(), r.seconds, c.hopf_per_steady, c.hopf_per_steady_listed);
+        std::fflush(stdout);
+      });
       runs.push_back(std::move(r));
       coarser = &runs.back().b;
     }

@@ -84,63 +84,31 @@ struct options {
   agard445_flutter::flutter_options flutter;
 };
 
-int stride_of(const std::string& level) {
-  if (level == "very_coarse") return 8;
-  if (level == "coarse") return 4;
-  if (level == "medium") return 2;
-  if (level == "fine") return 1;
-  throw input_error("unknown grid level '" + level + "' (very_coarse, coarse, medium, fine)");
-}
-
 options parse(int argc, char** argv) {
   options o;
   example_cli::arguments args(argc, argv);
   for (std::string a; args.next(a);) {
-    if (a == "--mesh") {
-      const std::string v = args.value();
-      const auto comma = v.find(',');
-      require(comma != std::string::npos, "--mesh takes NI,NJ (chordwise,spanwise quads), not ", v);
-      try {
-        o.ni = std::stoi(v.substr(0, comma));
-        o.nj = std::stoi(v.substr(comma + 1));
-      } catch (const std::exception&) {
-        throw input_error("--mesh takes two integers NI,NJ, not '" + v + "'");
-      }
-      require(o.ni >= 2 && o.nj >= 2 && o.ni <= 400 && o.nj <= 400, "--mesh: NI and NJ in [2, 400] (got ", o.ni, ",",
-              o.nj, ")");
+    if (agard445_flutter::read_mesh_option(a, args, o.ni, o.nj)) {
+      continue;
     } else if (a == "--modes") {
       o.modes = args.integer();
       require(o.modes >= 1 && o.modes <= 20, "--modes must lie in [1, 20] (got ", o.modes, ")");
     } else if (a == "--steady") {
       o.steady = args.value();
-      if (o.steady != "none") stride_of(o.steady);
+      if (o.steady != "none") agard445_flutter::stride_of(o.steady);
     } else if (a == "--fine-grid") {
       o.fine_grid = true;
-    } else if (a == "--flutter") {
-      o.flutter.strides.clear();
-      for (const auto& l : args.words())
-        if (l != "none") o.flutter.strides.push_back(stride_of(l));
-      std::sort(o.flutter.strides.begin(), o.flutter.strides.end(), std::greater<>());
-    } else if (a == "--damping" || a == "--fine-damping") {
-      auto& list = a == "--damping" ? o.flutter.damping_percent : o.flutter.fine_damping_percent;
-      list = args.numbers();
-      for (double z : list) require(z >= 0 && z < 50, a, ": percentages in [0, 50) (got ", z, ")");
-    } else if (a == "--machs") {
-      o.flutter.machs = args.numbers();
-      for (std::size_t k = 0; k < o.flutter.machs.size(); ++k)
-        require(o.flutter.machs[k] > 0.3 && o.flutter.machs[k] < 1.3 && (k == 0 || o.flutter.machs[k] > o.flutter.machs[k - 1]),
-                "--machs: increasing Mach numbers in (0.3, 1.3)");
+    } else if (agard445_flutter::read_boundary_option(a, args, o.flutter)) {
+      continue;
     } else if (a == "--vg") {
       const std::string l = args.value();
-      o.flutter.vg_stride = l == "none" ? 0 : stride_of(l);
+      o.flutter.vg_stride = l == "none" ? 0 : agard445_flutter::stride_of(l);
     } else if (a == "--march") {
       const std::string l = args.value();
-      o.flutter.march_stride = l == "none" ? 0 : stride_of(l);
+      o.flutter.march_stride = l == "none" ? 0 : agard445_flutter::stride_of(l);
     } else if (a == "--vg-mach") {
       o.flutter.vg_mach = args.number();
       require(o.flutter.vg_mach > 0.3 && o.flutter.vg_mach < 1.3, "--vg-mach must lie in (0.3, 1.3)");
-    } else if (a == "--verbose") {
-      o.flutter.verbose = true;
     } else if (!a.empty() && a[0] != '-') {
       o.out = a;
     } else {
@@ -148,25 +116,6 @@ options parse(int argc, char** argv) {
     }
   }
   return o;
-}
-
-struct solved {
-  structure::plate_mesh mesh;
-  structure::plate_modes modes;
-  double mass = 0, seconds = 0;
-};
-
-solved modes_on(const flow::wing_geometry& w, int ni, int nj, int count) {
-  const auto t0 = std::chrono::steady_clock::now();
-  solved s;
-  s.mesh = structure::wing_plate_mesh(w, ni, nj);
-  const structure::plate_matrices km = structure::assemble_plate(s.mesh, structure::agard445_6_mahogany(w.planform));
-  s.mass = structure::plate_mass(km);
-  structure::plate_mode_options mo;
-  mo.count = count;
-  s.modes = structure::plate_modes_of(km, structure::clamped_root(s.mesh, ni), mo);
-  s.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  return s;
 }
 
 }  // namespace
@@ -185,17 +134,17 @@ int main(int argc, char** argv) try {
   std::printf("  %-10s %9s", "mesh", "mass kg");
   for (int k = 1; k <= 5; ++k) std::printf("   mode %d", k);
   std::printf("   seconds\n");
-  solved chosen;
+  agard445_flutter::solved chosen;
   for (int n : {6, 12, 24, 48}) {
     const bool is_chosen = n == o.ni && n == o.nj;
-    const solved s = modes_on(w, n, n, shown);
+    const agard445_flutter::solved s = agard445_flutter::modes_on(w, n, n, shown);
     std::printf("  %-10s %9.4f", (std::to_string(n) + "x" + std::to_string(n)).c_str(), s.mass);
     for (int k = 0; k < 5; ++k) std::printf(" %8.2f", s.modes.frequency_hz(k));
     std::printf(" %9.3f\n", s.seconds);
     if (is_chosen) chosen = s;
   }
   if (chosen.mesh.nodes.empty()) {
-    chosen = modes_on(w, o.ni, o.nj, shown);
+    chosen = agard445_flutter::modes_on(w, o.ni, o.nj, shown);
     std::printf("  %-10s %9.4f", (std::to_string(o.ni) + "x" + std::to_string(o.nj)).c_str(), chosen.mass);
     for (int k = 0; k < 5; ++k) std::printf(" %8.2f", chosen.modes.frequency_hz(k));
     std::printf(" %9.3f\n", chosen.seconds);
@@ -254,7 +203,7 @@ int main(int argc, char** argv) try {
   csv_writer quality(o.out / "grid_quality.csv",
                      "level,points,cells,wing_points,min_volume,min_corner_ratio,collinear_cells,tip_min_corner_ratio");
   for (const std::string level : {"very_coarse", "coarse", "medium", "fine"}) {
-    const int s = stride_of(level);
+    const int s = agard445_flutter::stride_of(level);
     const flow::multiblock_grid<3> g = s == 1 ? fine : flow::coarsen(fine, s);
     const flow::grid_quality q = flow::hexahedron_quality(g);
     const auto [tip_lo, tip_hi] = flow::wing_grid_layout::of(go, s).tip_cells();
@@ -270,7 +219,7 @@ int main(int argc, char** argv) try {
 
   // 3. steady flow at M = 0.5 and the lift slope
   if (o.steady != "none") {
-    const int s = stride_of(o.steady);
+    const int s = agard445_flutter::stride_of(o.steady);
     const flow::multiblock_grid<3> g = s == 1 ? fine : flow::coarsen(fine, s);
     const double mach = 0.5, area = w.planform.area() / (w.planform.root_chord * w.planform.root_chord);
     csv_writer steady(o.out / ("steady_" + o.steady + ".csv"), "mach,alpha_deg,cl,cd,steps,gmres_iterations,seconds");
@@ -298,16 +247,14 @@ int main(int argc, char** argv) try {
   }
   // 4. the flutter boundaries and the V-g diagram (four modes)
   if (!o.flutter.strides.empty() || o.flutter.vg_stride || o.flutter.march_stride) {
-    require(md.modes() >= 4, "the flutter part needs four modes (--modes 4 or more)");
-    structure::modal_data four = md;
-    four.omega.conservativeResize(4);
-    four.generalised_mass.conservativeResize(4);
-    four.shapes.resize(4);
+    const structure::modal_data four = agard445_flutter::first_four(md);
     csv_writer exp(o.out / "experiment.csv", "mach,density,speed,mass_ratio,fsi,frequency_ratio");
     for (const auto& e : agard445_flutter::experiment())
       exp.row({e.mach, e.density, e.speed, e.mass_ratio, e.fsi, e.frequency_ratio});
     if (!o.flutter.strides.empty()) {
-      const auto runs = agard445_flutter::boundaries(o.flutter, o.out, w, go, four);
+      const auto runs = agard445_flutter::boundaries(
+          o.flutter, o.out, w, go, four, [](const models::wing_family& f) -> const models::wing_family& { return f; }, [](auto&& fn) { fn(); },
+          &std::cout);
       csv_writer costs(o.out / "costs.csv", "level,damping_percent,quantity,value");
       for (const auto& r : runs) {
         const flutter_boundary_costs c = boundary_costs(r.b, o.flutter.machs);

@@ -16,6 +16,7 @@
 #include <mpi.h>
 
 #include <aerohopf/bifurcation/hopf_bordered.hpp>
+#include <aerohopf/distributed/mpi_aerofoil.hpp>
 #include <aerohopf/distributed/mpi_hopf.hpp>
 #include <aerohopf/models/aerofoil_family.hpp>
 

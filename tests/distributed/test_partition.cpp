@@ -169,6 +169,16 @@ TEST(partition, a_single_block_wing_is_split_for_the_ranks) {
           r.segment(static_cast<Eigen::Index>(5 * s.original_cell[c]), 5);
     }
     EXPECT_LE((m.residual(ws) - rs_expected).cwiseAbs().maxCoeff(), 1e-13 * r.cwiseAbs().maxCoeff()) << ranks;
+    ASSERT_EQ(s.origin.size(), s.grid.points.blocks.size());
+    for (std::size_t b = 0; b < s.origin.size(); ++b) {  // the blocks' points: boxes of the input's
+      const auto& blk = s.grid.points.blocks[b];
+      EXPECT_EQ(s.origin[b].block, 0);
+      for (std::size_t k = 0; k < blk.n_points(); ++k) {
+        auto i = flow::unravel<3>(k, blk.points);
+        for (int d = 0; d < 3; ++d) i[d] += s.origin[b].offset[d];
+        ASSERT_EQ(blk.x[k], g.points.blocks[0].at(i)) << ranks << " ranks, block " << b << " point " << k;
+      }
+    }
     check_plans(m, ranks);
   }
   EXPECT_TRUE(contains(input_error_of([&] { split_for_ranks(g, 0); }), "0 ranks"));

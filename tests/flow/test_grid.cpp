@@ -297,6 +297,18 @@ void expect_same_residual(const multiblock_grid<Dim>& g, const split_grid<Dim>& 
       worst = std::max(worst, std::abs(rc[static_cast<Eigen::Index>(c * nv + v)] -
                                        r[static_cast<Eigen::Index>(s.original_cell[c] * nv + v)]));
   EXPECT_LE(worst, 1e-13 * r.cwiseAbs().maxCoeff());
+  // every block's points are the box of the input's points at its origin
+  if (s.origin.empty()) return;
+  ASSERT_EQ(s.origin.size(), s.grid.points.blocks.size());
+  for (std::size_t b = 0; b < s.origin.size(); ++b) {
+    const auto& blk = s.grid.points.blocks[b];
+    const auto& src = g.points.blocks.at(static_cast<std::size_t>(s.origin[b].block));
+    for (std::size_t k = 0; k < blk.n_points(); ++k) {
+      auto i = unravel<Dim>(k, blk.points);
+      for (int d = 0; d < Dim; ++d) i[d] += s.origin[b].offset[d];
+      ASSERT_EQ(blk.x[k], src.at(i)) << "block " << b << " point " << k;
+    }
+  }
 }
 
 }  // namespace
@@ -324,7 +336,7 @@ TEST(split_block, residual_is_unchanged_by_cuts_of_a_self_connected_wing_block_3
     // and the upper piece once more, along the other axis: original_cell composes
     const int other = axis == 0 ? 2 : 0;
     const auto s2 = split_block(s.grid, 1, other, s.grid.topology.cells[1][other] / 2);
-    split_grid<3> both{s2.grid, {}};
+    split_grid<3> both{s2.grid, {}, compose_origins(s.origin, s2.origin)};
     for (const std::size_t c : s2.original_cell) both.original_cell.push_back(s.original_cell[c]);
     expect_same_residual<3>(g, both, fs);
   }

@@ -10,6 +10,7 @@
 
 #include <aerohopf/bifurcation/hopf.hpp>
 #include <aerohopf/bifurcation/hopf_bordered.hpp>
+#include <aerohopf/distributed/partition.hpp>
 #include <aerohopf/error.hpp>
 #include <aerohopf/flow/wing_grid.hpp>
 #include <aerohopf/models/wing.hpp>
@@ -23,6 +24,7 @@
 #include <complex>
 #include <iostream>
 #include <numbers>
+#include <random>
 
 using namespace aerohopf;
 using models::wing_system;
@@ -103,6 +105,47 @@ TEST(wing_system, jacobians_are_the_derivatives_of_the_residual_at_rest_and_on_a
   }
   // the flow does no work on the modes at rest (symmetric section, zero incidence)
   EXPECT_LT(s.generalised_forces<double>(rest_equilibrium()).cwiseAbs().maxCoeff(), 1e-10);
+}
+
+// The system on the tiny grid cut into 3 blocks (as for 3 ranks) is the whole grid's system with
+// its cells reordered: residual, both Jacobians (products with a random vector) and the loads,
+// on a moved grid.
+TEST(wing_system, on_a_cut_grid_is_the_whole_grid_system_reordered) {
+  const wing_system s = tiny_wing(0.0, 0.02);
+  const auto cut = distributed::split_for_ranks(tiny_grid(), 3);
+  ASSERT_GE(cut.grid.points.blocks.size(), 3u);
+  const wing_system c = models::split_wing_system(s, cut);
+  ASSERT_EQ(c.size(), s.size());
+  const double mu = 0.075;
+  vec<double> w = rest_equilibrium();
+  for (Eigen::Index i = 0; i < s.structure_size(); ++i) w[s.flow_size() + i] = 0.002 * double(i % 3 - 1) + 0.001;
+  std::mt19937 rng(5);
+  std::normal_distribution<double> g;
+  for (Eigen::Index i = 0; i < s.flow_size(); ++i) w[i] *= 1.0 + 1e-3 * g(rng);  // the flow loads the wing
+  vec<double> x(s.size());
+  for (Eigen::Index i = 0; i < x.size(); ++i) x[i] = g(rng);
+  // whole-grid vector -> the cut system's order
+  const auto to_cut = [&](const vec<double>& v) { return flow::to_split_order(cut, v, 5); };
+  EXPECT_EQ(flow::from_split_order(cut, to_cut(x), 5), x);
+  EXPECT_EQ(to_cut(x).tail(s.structure_size()), x.tail(s.structure_size()));
+  const auto expect_near = [](const vec<double>& a, const vec<double>& b, const char* what) {
+    EXPECT_LE((a - b).cwiseAbs().maxCoeff(), 1e-12 * b.cwiseAbs().maxCoeff()) << what;
+  };
+  expect_near(c.residual<double>(to_cut(w), mu), to_cut(s.residual<double>(w, mu)), "residual");
+  expect_near(c.generalised_forces<double>(to_cut(w)), s.generalised_forces<double>(w), "generalised forces");
+  const auto js = s.bordered_jacobians(w, mu), jc = c.bordered_jacobians(to_cut(w), mu);
+  vec<double> ys(s.size()), yc(s.size());
+  js.exact.apply(x, ys);
+  jc.exact.apply(to_cut(x), yc);
+  expect_near(yc, to_cut(ys), "exact Jacobian");
+  js.preconditioning.apply(x, ys);
+  jc.preconditioning.apply(to_cut(x), yc);
+  expect_near(yc, to_cut(ys), "modified-order Jacobian");
+  // a cut that is not this grid's is refused
+  auto bad = cut;
+  bad.origin[1].offset[0] += 1;
+  EXPECT_THROW(models::split_wing_system(s, bad), input_error);
+  EXPECT_THROW(models::split_wing_system(c, cut), input_error);  // cut already
 }
 
 TEST(wing_system, generalised_forces_of_heave_and_pitch_are_the_lift_and_the_moment) {

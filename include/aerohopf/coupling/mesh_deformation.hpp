@@ -112,6 +112,8 @@ class wing_modal_motion {
   }
 
   Eigen::Index modes() const { return static_cast<Eigen::Index>(basis_.size()); }
+  /// The grid block at rest that the motion moves.
+  const flow::grid_block<double, 3>& rest() const { return rest_; }
   /// Psi_m at every point (root chords per unit a_hat_m).
   const std::vector<std::array<double, 3>>& basis(Eigen::Index m) const { return basis_.at(static_cast<std::size_t>(m)); }
 

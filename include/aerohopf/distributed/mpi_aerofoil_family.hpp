@@ -129,12 +129,7 @@ class aerofoil_family {
     distributed_aerofoil d(s, partition_blocks(s.flow(), ranks_), comm_);
     distributed_aerofoil::jacobian_rows a, p;
     d.jacobians(d.local_part(w), ubar, a, p);
-    distributed_inverse_power_options io;
-    io.power = so.inverse_power;
-    io.fill_level = so.fill_level;
-    io.linear.relative_tolerance = so.krylov.relative_tolerance;
-    io.linear.restart = so.krylov.restart;
-    io.linear.max_iterations = so.krylov.max_iterations;
+    const distributed_inverse_power_options io = internal::inverse_power_options_from(so);
     eigen_pair ep = inverse_power(d, a, so.precondition_exact ? nullptr : &p, {0.0, omega}, io);
     ep.vector = d.all_gather(ep.vector);
     aerohopf::internal::normalise_phase(ep.vector);
@@ -147,35 +142,11 @@ class aerofoil_family {
   hopf_result solve_hopf(const system_type& s, const hopf_point& guess, const hopf_options& ho,
                          const hopf_krylov_options& ko) const {
     distributed_aerofoil d(s, partition_blocks(s.flow(), ranks_), comm_);
-    distributed_hopf_options o;
-    o.hopf = ho;
-    o.fill_level = ko.fill_level;
-    o.krylov.restart = ko.krylov.restart;
-    o.krylov.max_iterations = ko.krylov.max_iterations;
-    o.eta_max = ko.eta_max;
-    o.start_iterations = ko.start_iterations;
-    o.start_tolerance = ko.start_tolerance;
-    o.start_max_iterations = ko.start_max_iterations;
-    o.start_residual_threshold = ko.start_residual_threshold;
-    distributed_hopf_point g{d.local_part(guess.w), guess.mu, guess.omega, d.local_part(guess.p)};
-    const distributed_hopf_result r = distributed::solve_hopf(d, g, o);
-    hopf_result h;
-    h.point.w = ho.fixed_equilibrium ? guess.w : d.all_gather(r.point.w);  // fixed: unchanged
-    h.point.mu = r.point.mu;
-    h.point.omega = r.point.omega;
-    h.point.p = d.all_gather(r.point.p);
-    // the normalisation e_k: p_k = i at the largest component
-    Eigen::Index k = 0;
-    h.point.p.cwiseAbs().maxCoeff(&k);
-    h.s = vec<double>::Zero(h.point.p.size());
-    h.s[k] = 1.0;
-    h.report = r.report;
-    h.linear_iterations = r.linear_iterations;
-    h.setup_seconds = r.setup_seconds;
-    h.linear_seconds = r.linear_seconds;
-    h.residual_seconds = r.residual_seconds;
-    h.start_refined = r.start_refined;
-    return h;
+    const distributed_hopf_point g{d.local_part(guess.w), guess.mu, guess.omega, d.local_part(guess.p)};
+    const distributed_hopf_result r = distributed::solve_hopf(d, g, internal::hopf_options_from(ho, ko));
+    vec<std::complex<double>> p = d.all_gather(r.point.p);  // collective calls in one order
+    vec<double> w = ho.fixed_equilibrium ? guess.w : d.all_gather(r.point.w);  // fixed: w unchanged
+    return internal::hopf_result_from(r, std::move(w), std::move(p));
   }
 
   flutter_boundary_options boundary_options() const { return serial_.boundary_options(); }

@@ -89,6 +89,17 @@ void collective(MPI_Comm comm, const char* what, F&& f) {
 
 }  // namespace internal
 
+/// fn() on rank 0 of comm only (output: printing, writing files), its failure thrown on every
+/// rank (as internal::collective: the others would otherwise wait in the next collective call).
+template <class F>
+void on_root(MPI_Comm comm, const char* what, F&& fn) {
+  int rank = 0;
+  internal::check_mpi(MPI_Comm_rank(comm, &rank), "MPI_Comm_rank");
+  internal::collective(comm, what, [&] {
+    if (rank == 0) fn();
+  });
+}
+
 template <int Dim>
 class distributed_euler {
  public:

@@ -1,35 +1,38 @@
 #pragma once
-// The Hopf (flutter) point of the pitch-plunge aerofoil on MPI ranks (distributed_aerofoil), in
-// both formulations of bifurcation/hopf.hpp:
-//  * fixed equilibrium: unknowns [p_r, p_i, Ubar, omega], w given (the section at rest at zero
-//    incidence, the equilibrium independent of Ubar);
-//  * full: unknowns [w, p_r, p_i, Ubar, omega], the equilibrium moving with Ubar (a mean
-//    incidence: the static pitch deflection depends on Ubar).
+// The Hopf (flutter) point of an aeroelastic system on MPI ranks (a model derived from
+// distributed_bordered, mpi_bordered.hpp: the pitch-plunge aerofoil with parameter Ubar, the
+// modal wing with parameter mu), in both formulations of bifurcation/hopf.hpp:
+//  * fixed equilibrium: unknowns [p_r, p_i, mu, omega], w given (the structure at rest at zero
+//    incidence, the equilibrium independent of mu);
+//  * full: unknowns [w, p_r, p_i, mu, omega], the equilibrium moving with mu (a mean incidence:
+//    the static deflection depends on mu).
 // F_A as in hopf.hpp, with the normalisation s = e_k, k the largest component of the start's p
 // over all ranks (p_k = i), so F_A's border rows are sparse on the ranks too.
 //
-// Vectors: each rank holds its part of w, p_r and p_i (distributed_aerofoil's local order: its
-// flow values, then the structure, significant on the root); Ubar and omega are held by every
-// rank, and in the Newton correction, as the structure, on the root only, so that a sum over
-// the ranks of local inner products counts every unknown once.
+// Vectors: each rank holds its part of w, p_r and p_i (the model's local order: its flow
+// values, then the structure, significant on the root); mu and omega are held by every rank,
+// and in the Newton correction, as the structure, on the root only, so that a sum over the
+// ranks of local inner products counts every unknown once.
 //
 // Newton step: the bordered elimination of hopf_bordered.hpp (bordered_hopf_step), every solve
 // by GMRES on the ranks.
 //  * The eigen-equations and the border: GMRES on the exact real (2n + 2) bordered matrix, its
 //    inner operator the complex product with J - i omega I (the Jacobian rows assembled on the
-//    ranks, distributed_aerofoil::multiply), right-preconditioned by the complex block-Jacobi
+//    ranks, distributed_bordered::multiply), right-preconditioned by the complex block-Jacobi
 //    BILU(k) of L - i omega I (L the modified-order rows, the structural border eliminated exactly:
-//    distributed_aerofoil_preconditioner) with the two Hopf border unknowns eliminated around it.
-//  * The full formulation's flow update: dw0 = -A^{-1} f, dw1 = -A^{-1} f_Ubar by real GMRES on
+//    basic_distributed_bordered_preconditioner) with the two Hopf border unknowns eliminated
+//    around it. The mu column A_mu p is the model's parameter_column.
+//  * The full formulation's flow update: dw0 = -A^{-1} f, dw1 = -A^{-1} f_mu by real GMRES on
 //    A preconditioned by the real BILU(k) of L; the second-derivative products (A_w p) dw by
 //    central differences of the Jacobian rows re-assembled at w +- h dw (O(h^2): the rate of
 //    Newton's convergence only).
-// F_A is evaluated with the exact Jacobian rows at the iterate. Ubar enters only the structural
-// stiffness, so in the fixed-equilibrium formulation the rows are assembled once and moved to
-// each iterate's Ubar exactly (distributed_aerofoil::set_ubar): the operator of every GMRES
-// solve is the exact Jacobian and the convergence is quadratic with inexact solves. The
-// preconditioner is computed at the start and again after a step that reduced ||F|| less than
-// tenfold; in the full formulation everything is re-assembled at every iterate (A moves with w).
+// F_A is evaluated with the exact Jacobian rows at the iterate. mu enters only the structural
+// border (the aerofoil's stiffness, the wing's force scale), so in the fixed-equilibrium
+// formulation the rows are assembled once and moved to each iterate's mu exactly (the model's
+// set_parameter): the operator of every GMRES solve is the exact Jacobian and the convergence
+// is quadratic with inexact solves. The preconditioner is computed at the start and again after
+// a step that reduced ||F|| less than tenfold; in the full formulation everything is
+// re-assembled at every iterate (A moves with w).
 //
 // Start refinement (fixed formulation, distributed_hopf_options::start_iterations, as the serial
 // solve_hopf_krylov's): a continued guess whose eigenvector is far off (||F|| above a threshold)
@@ -38,18 +41,20 @@
 //
 // Stopping and checks (as hopf.hpp, sums over the ranks): ||F_A|| <= abs_tolerance +
 // rel_tolerance ||F_A(start)|| (hopf_options::newton; its rounding-floor test is not used);
-// failure (convergence_error on every rank, naming the iterate, ||F||, Ubar and omega) on a
+// failure (convergence_error on every rank, naming the iterate, ||F||, mu and omega) on a
 // non-finite or diverging residual (> divergence_factor ||F_0||), a residual that grows more than
 // max_contraction-fold in one step from iteration contraction_from on, a GMRES failure, or the
 // iteration limit; with newton.throw_on_failure = false the result holds the last iterate
 // instead, report.converged = false. A converged point is accepted if the equilibrium holds at
-// Ubar* (fixed formulation: ||f(w, Ubar*)|| <= max(equilibrium_tolerance, equilibrium_factor
-// ||F||)) and omega is resolved (|omega| > 10 ||F|| / ||p||); omega > 0 on return.
+// mu* (fixed formulation: ||f(w, mu*)|| <= max(equilibrium_tolerance, equilibrium_factor
+// ||F||)) and omega is resolved (|omega| > 10 ||F|| / ||p||); omega > 0 on return. Messages
+// name the parameter as the model does (Ubar, mu).
 
 #include <mpi.h>
 
 #include <aerohopf/bifurcation/hopf.hpp>
-#include <aerohopf/distributed/mpi_aerofoil.hpp>
+#include <aerohopf/bifurcation/hopf_bordered.hpp>
+#include <aerohopf/distributed/mpi_bordered.hpp>
 #include <aerohopf/linalg/krylov.hpp>
 
 #include <Eigen/LU>
@@ -94,7 +99,7 @@ struct distributed_hopf_options {
 /// A Hopf point's guess or result on the ranks: this rank's parts of w and p.
 struct distributed_hopf_point {
   vec<double> w;                   ///< this rank's part of the equilibrium
-  double mu = NAN, omega = NAN;    ///< Ubar and omega (every rank)
+  double mu = NAN, omega = NAN;    ///< the parameter (Ubar, mu) and omega (every rank)
   vec<std::complex<double>> p;     ///< this rank's part of the eigenvector
 };
 
@@ -111,11 +116,12 @@ namespace internal {
 /// The real (2n + 2) bordered matrix of the eigen-equations in the real split form on the ranks:
 /// v = [x_r, x_i, a, b] (each rank its parts of x_r and x_i; a, b on the root) ->
 ///   [(J x)_r + omega x_i + a m_r + b p_i;  (J x)_i - omega x_r + a m_i - b p_r;  s.x_r;  s.x_i]
-/// with m = the Ubar column and s the normalisation (sums over the ranks, rows on the root).
+/// with m = the mu column and s the normalisation (sums over the ranks, rows on the root).
+template <int Dim>
 class hopf_bordered_operator {
  public:
   using C = std::complex<double>;
-  hopf_bordered_operator(distributed_aerofoil& d, const distributed_aerofoil::jacobian_rows& j, double omega,
+  hopf_bordered_operator(distributed_bordered<Dim>& d, const bordered_rows<Dim>& j, double omega,
                          vec<double> mu_column, const vec<double>& pr, const vec<double>& pi, const vec<double>& s)
       : d_(&d), j_(&j), omega_(omega), n_(d.local_size()), mu_col_(std::move(mu_column)), om_col_(2 * n_), s_(&s) {
     om_col_ << pi, -pr;
@@ -138,14 +144,14 @@ class hopf_bordered_operator {
     y.head(2 * n_) += ab[0] * mu_col_ + ab[1] * om_col_;
     std::array<double, 2> sx{s_->dot(v.head(n_)), s_->dot(v.segment(n_, n_))};
     d_->sum(sx.data(), 2);
-    y[2 * n_] = d_->rank() == distributed_aerofoil::root ? sx[0] : 0.0;
-    y[2 * n_ + 1] = d_->rank() == distributed_aerofoil::root ? sx[1] : 0.0;
+    y[2 * n_] = d_->rank() == distributed_bordered<Dim>::root ? sx[0] : 0.0;
+    y[2 * n_ + 1] = d_->rank() == distributed_bordered<Dim>::root ? sx[1] : 0.0;
   }
   void global_sum(double* p, int n) const { d_->sum(p, n); }
 
  private:
-  distributed_aerofoil* d_;
-  const distributed_aerofoil::jacobian_rows* j_;
+  distributed_bordered<Dim>* d_;
+  const bordered_rows<Dim>* j_;
   double omega_;
   Eigen::Index n_;
   vec<double> mu_col_, om_col_;
@@ -155,11 +161,12 @@ class hopf_bordered_operator {
 /// Its preconditioner: the complex preconditioner M of L - i omega I in the split form, the two
 /// border unknowns eliminated around it (W = M^{-1} [m, omega column], 2 x 2 Schur complement
 /// -s^T W summed over the ranks): one application of M and one reduction of four values.
+template <int Dim>
 class hopf_bordered_preconditioner {
  public:
   using C = std::complex<double>;
-  hopf_bordered_preconditioner(const distributed_aerofoil_preconditioner& m, distributed_aerofoil& d,
-                               const hopf_bordered_operator& op)
+  hopf_bordered_preconditioner(const basic_distributed_bordered_preconditioner<Dim, std::complex<double>>& m,
+                               distributed_bordered<Dim>& d, const hopf_bordered_operator<Dim>& op)
       : m_(&m), d_(&d), n_(d.local_size()), s_(&op.s()), w_(2 * n_, 2) {
     vec<double> z(2 * n_);
     split_apply(op.mu_column(), z);
@@ -177,14 +184,14 @@ class hopf_bordered_preconditioner {
     if (!schur.allFinite() || !(std::abs(schur.determinant()) > 0))
       throw singular_matrix_error(aerohopf::internal::concat(
           "distributed Hopf preconditioner: the 2 x 2 Schur complement of the border is singular or not finite (det ",
-          schur.determinant(), "): Ubar and omega not determined"));
+          schur.determinant(), "): the parameter and omega not determined"));
     schur_inv_ = schur.inverse();
   }
   Eigen::Index rows() const { return 2 * n_ + 2; }
   void apply(const vec<double>& r, vec<double>& z) const {
     vec<double> z1(2 * n_);
     split_apply(r.head(2 * n_), z1);
-    const bool root = d_->rank() == distributed_aerofoil::root;  // the border rows: the root's
+    const bool root = d_->rank() == distributed_bordered<Dim>::root;  // the border rows: the root's
     std::array<double, 2> t{(root ? r[2 * n_] : 0.0) - s_->dot(z1.head(n_)),
                             (root ? r[2 * n_ + 1] : 0.0) - s_->dot(z1.segment(n_, n_))};
     d_->sum(t.data(), 2);
@@ -194,8 +201,8 @@ class hopf_bordered_preconditioner {
     const std::array<double, 2> sol{s0, s1};
     z.resize(rows());
     z.head(2 * n_) = z1 - s0 * w_.col(0) - s1 * w_.col(1);
-    z[2 * n_] = d_->rank() == distributed_aerofoil::root ? sol[0] : 0.0;
-    z[2 * n_ + 1] = d_->rank() == distributed_aerofoil::root ? sol[1] : 0.0;
+    z[2 * n_] = d_->rank() == distributed_bordered<Dim>::root ? sol[0] : 0.0;
+    z[2 * n_ + 1] = d_->rank() == distributed_bordered<Dim>::root ? sol[1] : 0.0;
   }
 
  private:
@@ -208,8 +215,8 @@ class hopf_bordered_preconditioner {
     z.head(n_) = zc.real();
     z.segment(n_, n_) = zc.imag();
   }
-  const distributed_aerofoil_preconditioner* m_;
-  distributed_aerofoil* d_;
+  const basic_distributed_bordered_preconditioner<Dim, std::complex<double>>* m_;
+  distributed_bordered<Dim>* d_;
   Eigen::Index n_;
   const vec<double>* s_;
   Eigen::MatrixXd w_;
@@ -218,21 +225,25 @@ class hopf_bordered_preconditioner {
 
 }  // namespace internal
 
-/// Newton on the Hopf system of a distributed_aerofoil from `guess` (file comment), the
+/// Newton on the Hopf system of a distributed model (distributed_aerofoil, distributed_wing)
+/// from `guess` (file comment), the
 /// formulation from opt.hopf.fixed_equilibrium. Collective: every rank passes its parts and gets
-/// the same Ubar*, omega* and its part of w* and p*. input_error (every rank) for a guess of the
+/// the same mu*, omega* and its part of w* and p*. input_error (every rank) for a guess of the
 /// wrong sizes, not finite, a zero eigenvector or bad options; convergence_error or
 /// singular_matrix_error (every rank) for a failure, as the file comment says.
-inline distributed_hopf_result solve_hopf(distributed_aerofoil& d, const distributed_hopf_point& guess,
+template <class D>
+distributed_hopf_result solve_hopf(D& d, const distributed_hopf_point& guess,
                                           const distributed_hopf_options& opt = {}) {
   using C = std::complex<double>;
+  constexpr int dim = D::nv - 2;
   const hopf_options& ho = opt.hopf;
   const bool fixed = ho.fixed_equilibrium;
   const std::string who = fixed ? "distributed solve_hopf" : "distributed solve_hopf (full system)";
   const std::string label = ho.label;
   const MPI_Comm comm = d.communicator();
   const Eigen::Index n = d.local_size();
-  const bool root = d.rank() == distributed_aerofoil::root;
+  const bool root = d.rank() == D::root;
+  const std::string param = d.parameter_name();
   internal::collective(comm, who.c_str(), [&] {
     aerohopf::internal::check_hopf_options(ho, who);
     validate_krylov_options(opt.krylov, who);
@@ -248,11 +259,11 @@ inline distributed_hopf_result solve_hopf(distributed_aerofoil& d, const distrib
             ": start_residual_threshold must be finite and >= 0 (got ", opt.start_residual_threshold, ")");
     require(fixed || opt.start_iterations == 0, who, ": the start refinement (start_iterations = ", opt.start_iterations,
             ") is available only in the fixed-equilibrium formulation; set it to 0");
-    require_size(guess.w.size(), n, who, "guess.w (this rank's flow values and 4 structural)");
+    require_size(guess.w.size(), n, who, "guess.w (this rank's flow values and the structural ones)");
     require_size(guess.p.size(), n, who, "guess.p (this rank's part of the eigenvector)");
     require_finite(guess.w, who, "guess.w");
     require_finite(guess.p, who, "guess.p");
-    require(std::isfinite(guess.mu) && guess.mu != 0, who, ": guess.mu (Ubar) ", guess.mu, " must be finite and non-zero");
+    require(std::isfinite(guess.mu) && guess.mu != 0, who, ": guess.mu (", param, ") ", guess.mu, " must be finite and non-zero");
     require(std::isfinite(guess.omega), who, ": guess.omega ", guess.omega, " is not finite");
   });
   {
@@ -290,14 +301,14 @@ inline distributed_hopf_result solve_hopf(distributed_aerofoil& d, const distrib
   vec<double> w = guess.w, pr = p.real(), pi = p.imag();
   double mu = guess.mu, om = guess.omega;
   distributed_hopf_result res;
-  distributed_aerofoil::jacobian_rows a, l, ap, am;
+  typename D::jacobian_rows a, l, ap, am;
   block_ilu_options io;
   io.fill_level = opt.fill_level;
   io.context = aerohopf::internal::concat(label, ": block-Jacobi BILU(", opt.fill_level, ") of L - i omega I");
-  distributed_aerofoil_preconditioner pc(io);
+  basic_distributed_bordered_preconditioner<dim, C> pc(io);
   block_ilu_options ior = io;
   ior.context = aerohopf::internal::concat(label, ": block-Jacobi BILU(", opt.fill_level, ") of L (flow update)");
-  basic_distributed_aerofoil_preconditioner<double> pc_real(ior);
+  basic_distributed_bordered_preconditioner<dim, double> pc_real(ior);
   bool preconditioned = false;
 
   // F_A at the iterate (local parts; border rows on the root) with the Jacobian rows a at (w, mu)
@@ -333,7 +344,7 @@ inline distributed_hopf_result solve_hopf(distributed_aerofoil& d, const distrib
   };
   auto precondition = [&]() {
     const auto t0 = aerohopf::internal::hopf_clock::now();
-    d.set_ubar(l, mu);
+    d.set_parameter(l, mu);
     pc.compute(d, l, C(0.0, om));
     if (!fixed) pc_real.compute(d, l, 0.0);
     preconditioned = true;
@@ -344,7 +355,7 @@ inline distributed_hopf_result solve_hopf(distributed_aerofoil& d, const distrib
   auto& rep = res.report;
   const auto t_start = aerohopf::internal::hopf_clock::now();
   auto where = [&](int k, double fk) {
-    return aerohopf::internal::concat(" [iterate ", k, ": ||F|| = ", fk, ", Ubar = ", mu, ", omega = ", om, "]");
+    return aerohopf::internal::concat(" [iterate ", k, ": ||F|| = ", fk, ", ", param, " = ", mu, ", omega = ", om, "]");
   };
   auto fail = [&](const std::string& why, int k, double fk) {
     rep.converged = false;
@@ -358,7 +369,7 @@ inline distributed_hopf_result solve_hopf(distributed_aerofoil& d, const distrib
   if (fixed && opt.start_iterations > 0 && fn > opt.start_residual_threshold) {
     const auto t0 = aerohopf::internal::hopf_clock::now();
     precondition();
-    const distributed_aerofoil_operator op(d, a, C(0.0, om));
+    const distributed_shifted_operator<dim> op(d, a, C(0.0, om));
     krylov_options ko = opt.krylov;
     ko.relative_tolerance = opt.start_tolerance;
     ko.max_iterations = std::min(ko.max_iterations, opt.start_max_iterations);
@@ -419,7 +430,7 @@ inline distributed_hopf_result solve_hopf(distributed_aerofoil& d, const distrib
   double last = fn;
   if (ho.verbose && ho.log && root)
     *ho.log << label << " it  0  |F| " << std::scientific << std::setprecision(3) << fn << std::defaultfloat
-            << "  Ubar " << std::setprecision(12) << mu << "  omega " << om << "\n";
+            << "  " << param << " " << std::setprecision(12) << mu << "  omega " << om << "\n";
   for (int k = 0;; ++k) {
     if (!std::isfinite(fn)) {
       fail("the Hopf residual is not finite", k, fn);
@@ -452,19 +463,17 @@ inline distributed_hopf_result solve_hopf(distributed_aerofoil& d, const distrib
       ko.throw_on_failure = true;
       vec<double> mu_col(2 * n);
       {
-        const Eigen::MatrixXd b = d.structure_d_ubar(mu);
-        mu_col.setZero();
-        const vec<double> psr = d.structure_of(pr), psi = d.structure_of(pi);
-        if (root) {
-          constexpr int ns = distributed_aerofoil::ns;
-          mu_col.segment(n - ns, ns) = b * psr;
-          mu_col.segment(2 * n - ns, ns) = b * psi;
-        }
+        vec<C> pcx(n);
+        pcx.real() = pr;
+        pcx.imag() = pi;
+        const vec<C> mc = d.parameter_column(a, pcx);  // A_mu p at the rows' mu (= mu)
+        mu_col.head(n) = mc.real();
+        mu_col.tail(n) = mc.imag();
       }
       vec<double> rhs = -f.tail(2 * n + 2);
       vec<double> dw0, dw1;
       if (!fixed) {
-        const real_aerofoil_operator aop(d, a);
+        const real_bordered_operator<dim> aop(d, a);
         const auto t0 = aerohopf::internal::hopf_clock::now();
         dw0 = vec<double>::Zero(n);
         dw1 = vec<double>::Zero(n);
@@ -472,7 +481,7 @@ inline distributed_hopf_result solve_hopf(distributed_aerofoil& d, const distrib
         res.linear_iterations += gmres<double>(aop, pc_real, vec<double>(-f.head(n)), dw0, ko).iterations;
         ko.context = aerohopf::internal::concat(label, ": GMRES on A (flow update dw1) at Newton iteration ", k + 1);
         res.linear_iterations +=
-            gmres<double>(aop, pc_real, vec<double>(-d.residual_d_ubar(w, mu)), dw1, ko).iterations;
+            gmres<double>(aop, pc_real, vec<double>(-d.residual_d_parameter(w, mu)), dw1, ko).iterations;
         res.linear_seconds += aerohopf::internal::seconds_since(t0);
         // (A_w p) dw by central differences of the Jacobian rows at w +- h dw
         const auto t1 = aerohopf::internal::hopf_clock::now();
@@ -501,8 +510,8 @@ inline distributed_hopf_result solve_hopf(distributed_aerofoil& d, const distrib
         res.residual_seconds += aerohopf::internal::seconds_since(t1);
       }
       const auto t0 = aerohopf::internal::hopf_clock::now();
-      const internal::hopf_bordered_operator op(d, a, om, std::move(mu_col), pr, pi, s);
-      const internal::hopf_bordered_preconditioner bp(pc, d, op);
+      const internal::hopf_bordered_operator<dim> op(d, a, om, std::move(mu_col), pr, pi, s);
+      const internal::hopf_bordered_preconditioner<dim> bp(pc, d, op);
       vec<double> dx = vec<double>::Zero(2 * n + 2);
       ko.context = aerohopf::internal::concat(label, ": GMRES on the bordered eigen-equations at Newton iteration ", k + 1);
       res.linear_iterations += gmres<double>(op, bp, rhs, dx, ko).iterations;
@@ -516,7 +525,7 @@ inline distributed_hopf_result solve_hopf(distributed_aerofoil& d, const distrib
       pi += dx.segment(n, n);
       mu += dm[0];
       om += dm[1];
-      if (fixed) d.set_ubar(a, mu);
+      if (fixed) d.set_parameter(a, mu);
       else assemble();
       last = fn;
       f = residual();
@@ -525,7 +534,7 @@ inline distributed_hopf_result solve_hopf(distributed_aerofoil& d, const distrib
       rep.residual_history.push_back(fn);
       if (ho.verbose && ho.log && root)
         *ho.log << label << " it " << std::setw(2) << k + 1 << "  |F| " << std::scientific << std::setprecision(3) << fn
-                << std::defaultfloat << "  Ubar " << std::setprecision(12) << mu << "  omega " << om << "  linear its "
+                << std::defaultfloat << "  " << param << " " << std::setprecision(12) << mu << "  omega " << om << "  linear its "
                 << res.linear_iterations << "\n";
     } catch (const input_error&) {
       throw;
@@ -561,13 +570,13 @@ inline distributed_hopf_result solve_hopf(distributed_aerofoil& d, const distrib
   const double p_norm = std::sqrt(p_norm2);
   std::string why;
   if (!(f_eq <= tol_f))
-    why = aerohopf::internal::concat("the equilibrium does not hold at Ubar* = ", mu, ": ||f(w, Ubar*)|| = ", f_eq,
+    why = aerohopf::internal::concat("the equilibrium does not hold at ", param, "* = ", mu, ": ||f(w, ", param, "*)|| = ", f_eq,
                                      " > tolerance ", tol_f,
-                                     fixed ? " (fixed-equilibrium formulation: an equilibrium that moves with Ubar "
-                                             "needs the full one)"
+                                     fixed ? " (fixed-equilibrium formulation: an equilibrium that moves with the "
+                                             "parameter needs the full one)"
                                            : "");
   else if (!(std::abs(om) > aerohopf::internal::hopf_frequency_floor(r, p_norm)))
-    why = aerohopf::internal::concat("converged to omega = ", om, " at Ubar* = ", mu,
+    why = aerohopf::internal::concat("converged to omega = ", om, " at ", param, "* = ", mu,
                                      ", below the resolved frequency: a real eigenvalue (divergence), not a Hopf point");
   if (!why.empty()) {
     rep.converged = false;
@@ -576,5 +585,58 @@ inline distributed_hopf_result solve_hopf(distributed_aerofoil& d, const distrib
   }
   return res;
 }
+
+namespace internal {
+
+/// The distributed Hopf options of a flutter-boundary driver's serial ones (formulation, Newton,
+/// BILU fill, GMRES restart and limit, forcing bound, start refinement): the distributed
+/// families' solve_hopf.
+inline distributed_hopf_options hopf_options_from(const hopf_options& ho, const hopf_krylov_options& ko) {
+  distributed_hopf_options o;
+  o.hopf = ho;
+  o.fill_level = ko.fill_level;
+  o.krylov.restart = ko.krylov.restart;
+  o.krylov.max_iterations = ko.krylov.max_iterations;
+  o.eta_max = ko.eta_max;
+  o.start_iterations = ko.start_iterations;
+  o.start_tolerance = ko.start_tolerance;
+  o.start_max_iterations = ko.start_max_iterations;
+  o.start_residual_threshold = ko.start_residual_threshold;
+  return o;
+}
+
+/// The distributed inverse-power options of a driver's Hopf start (hopf_start_krylov's).
+inline distributed_inverse_power_options inverse_power_options_from(const hopf_start_krylov_options& so) {
+  distributed_inverse_power_options io;
+  io.power = so.inverse_power;
+  io.fill_level = so.fill_level;
+  io.linear.relative_tolerance = so.krylov.relative_tolerance;
+  io.linear.restart = so.krylov.restart;
+  io.linear.max_iterations = so.krylov.max_iterations;
+  return io;
+}
+
+/// The serial hopf_result of a distributed one, with the whole w and p (gathered by the
+/// caller); its normalisation e_k: p_k = i at the largest component.
+inline hopf_result hopf_result_from(const distributed_hopf_result& r, vec<double> w, vec<std::complex<double>> p) {
+  hopf_result h;
+  h.point.w = std::move(w);
+  h.point.mu = r.point.mu;
+  h.point.omega = r.point.omega;
+  h.point.p = std::move(p);
+  Eigen::Index k = 0;
+  if (h.point.p.size()) h.point.p.cwiseAbs().maxCoeff(&k);
+  h.s = vec<double>::Zero(h.point.p.size());
+  if (h.s.size()) h.s[k] = 1.0;
+  h.report = r.report;
+  h.linear_iterations = r.linear_iterations;
+  h.setup_seconds = r.setup_seconds;
+  h.linear_seconds = r.linear_seconds;
+  h.residual_seconds = r.residual_seconds;
+  h.start_refined = r.start_refined;
+  return h;
+}
+
+}  // namespace internal
 
 }  // namespace aerohopf::distributed

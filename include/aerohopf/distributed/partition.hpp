@@ -87,7 +87,7 @@ block_partition partition_blocks(const flow::euler_model<Dim>& m, int ranks) {
 /// partition_blocks(...).imbalance()). A single-block wing grid becomes `ranks` blocks of equal
 /// size where its longest axis divides so (the AGARD medium grid for 3 ranks: 3 blocks; halving
 /// alone made 17).
-/// original_cell maps the result's cells to g's.
+/// original_cell maps the result's cells to g's, origin its blocks' points to g's.
 template <int Dim>
 flow::split_grid<Dim> split_for_ranks(const flow::multiblock_grid<Dim>& g, int ranks, double max_imbalance = 1.1) {
   require(ranks >= 1, "split_for_ranks: ", ranks, " ranks (at least 1)");
@@ -97,6 +97,8 @@ flow::split_grid<Dim> split_for_ranks(const flow::multiblock_grid<Dim>& g, int r
   for (const auto& c : g.topology.cells) total += flow::product<Dim>(c);
   cur.original_cell.resize(total);
   std::iota(cur.original_cell.begin(), cur.original_cell.end(), std::size_t{0});
+  cur.origin.resize(g.topology.cells.size());
+  for (std::size_t b = 0; b < cur.origin.size(); ++b) cur.origin[b].block = static_cast<int>(b);
   while (true) {
     const auto& cells = cur.grid.topology.cells;
     std::vector<std::size_t> n(cells.size());
@@ -112,6 +114,7 @@ flow::split_grid<Dim> split_for_ranks(const flow::multiblock_grid<Dim>& g, int r
       at = std::clamp(static_cast<int>(std::lround(len * share / static_cast<double>(n[big]))), 2, len - 2);
     auto next = flow::split_block(cur.grid, big, axis, at);
     for (auto& c : next.original_cell) c = cur.original_cell[c];
+    next.origin = flow::compose_origins(cur.origin, next.origin);
     cur = std::move(next);
   }
   return cur;

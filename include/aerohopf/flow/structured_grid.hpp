@@ -200,11 +200,21 @@ multiblock_grid<Dim> coarsen(const multiblock_grid<Dim>& fine, int m) {
   return g;
 }
 
-/// A grid with one block cut in two (split_block) and where each of its cells came from.
+/// Where a block's points lie in another grid: the box of block `block` from point index
+/// `offset`, the block's own point counts wide (index directions kept).
+template <int Dim>
+struct block_origin {
+  int block = 0;
+  std::array<int, Dim> offset{};
+};
+
+/// A grid with one block cut in two (split_block) and where each of its cells and points came
+/// from. `origin` may be empty (a grid made by hand): then it is not known.
 template <int Dim>
 struct split_grid {
   multiblock_grid<Dim> grid;
-  std::vector<std::size_t> original_cell;  // for each cell of `grid` (blocks in order), its cell in the input
+  std::vector<std::size_t> original_cell;     // for each cell of `grid` (blocks in order), its cell in the input
+  std::vector<block_origin<Dim>> origin = {};  // for each block of `grid`, where its points lie in the input
 };
 
 /// Cuts block b of g at cell index `at` along `axis`: cells [0, at) stay block b, cells [at, n)
@@ -353,6 +363,51 @@ split_grid<Dim> split_block(const multiblock_grid<Dim>& g, int b, int axis, int 
       out.original_cell.push_back(offset[src] + linear_index<Dim>(i, g.topology.cells[src]));
     }
   }
+  out.origin.resize(static_cast<std::size_t>(nb) + 1);
+  for (int k = 0; k < nb; ++k) out.origin[static_cast<std::size_t>(k)].block = k;
+  out.origin[static_cast<std::size_t>(nu)].block = b;
+  out.origin[static_cast<std::size_t>(nu)].offset[static_cast<std::size_t>(axis)] = at;
+  return out;
+}
+
+/// The origins of split_block(s.grid, ...)'s blocks (`next`) in the grid s was cut from.
+template <int Dim>
+std::vector<block_origin<Dim>> compose_origins(const std::vector<block_origin<Dim>>& s,
+                                               const std::vector<block_origin<Dim>>& next) {
+  std::vector<block_origin<Dim>> out;
+  out.reserve(next.size());
+  for (const auto& o : next) {
+    require(o.block >= 0 && static_cast<std::size_t>(o.block) < s.size(), "compose_origins: block ", o.block, " of ",
+            s.size());
+    block_origin<Dim> c = s[static_cast<std::size_t>(o.block)];
+    for (int d = 0; d < Dim; ++d) c.offset[static_cast<std::size_t>(d)] += o.offset[static_cast<std::size_t>(d)];
+    out.push_back(c);
+  }
+  return out;
+}
+
+/// A field of s's input grid (nv values per cell, in its cell order; any values past the cells,
+/// e.g. a structure's, kept in place) in the cut grid's cell order; from_split_order: back.
+template <int Dim, class T>
+Eigen::Matrix<T, Eigen::Dynamic, 1> to_split_order(const split_grid<Dim>& s, const Eigen::Matrix<T, Eigen::Dynamic, 1>& v,
+                                                   int nv) {
+  const auto nc = static_cast<Eigen::Index>(s.original_cell.size()) * nv;
+  require(nv >= 1 && v.size() >= nc, "to_split_order: a field of ", v.size(), " values for ", s.original_cell.size(),
+          " cells x ", nv);
+  Eigen::Matrix<T, Eigen::Dynamic, 1> out = v;
+  for (std::size_t k = 0; k < s.original_cell.size(); ++k)
+    out.segment(static_cast<Eigen::Index>(k) * nv, nv) = v.segment(static_cast<Eigen::Index>(s.original_cell[k]) * nv, nv);
+  return out;
+}
+template <int Dim, class T>
+Eigen::Matrix<T, Eigen::Dynamic, 1> from_split_order(const split_grid<Dim>& s,
+                                                     const Eigen::Matrix<T, Eigen::Dynamic, 1>& v, int nv) {
+  const auto nc = static_cast<Eigen::Index>(s.original_cell.size()) * nv;
+  require(nv >= 1 && v.size() >= nc, "from_split_order: a field of ", v.size(), " values for ", s.original_cell.size(),
+          " cells x ", nv);
+  Eigen::Matrix<T, Eigen::Dynamic, 1> out = v;
+  for (std::size_t k = 0; k < s.original_cell.size(); ++k)
+    out.segment(static_cast<Eigen::Index>(s.original_cell[k]) * nv, nv) = v.segment(static_cast<Eigen::Index>(k) * nv, nv);
   return out;
 }
 

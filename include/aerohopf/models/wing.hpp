@@ -67,9 +67,13 @@ class wing_system {
 
   /// flow: the Euler model on the rest grid (its options().force_tag names the loaded walls and
   /// must be set); motion: the modal grid motion of that grid; structure: reduced frequencies and
-  /// damping of the same modes.
-  wing_system(flow::euler_model<3> flow, coupling::wing_modal_motion motion, structure::modal_structure structure)
-      : flow_(std::move(flow)), motion_(std::move(motion)), structure_(std::move(structure)) {
+  /// damping of the same modes. `origins`: for a flow grid cut into blocks (split_wing_system
+  /// below), where each block's points lie in the motion's one-block grid; empty: the flow grid
+  /// is the motion's grid itself.
+  wing_system(flow::euler_model<3> flow, coupling::wing_modal_motion motion, structure::modal_structure structure,
+              std::vector<flow::block_origin<3>> origins = {})
+      : flow_(std::move(flow)), motion_(std::move(motion)), structure_(std::move(structure)),
+        origins_(std::move(origins)) {
     const char* who = "wing_system";
     const auto& opt = flow_.options();
     require(opt.wall == flow::euler_options::wall_flux::extrapolated, who,
@@ -80,14 +84,30 @@ class wing_system {
     require(motion_.modes() == structure_.modes(), who, ": the grid motion has ", motion_.modes(),
             " modes, the structure ", structure_.modes());
     const auto& grid = flow_.grid();
-    require(grid.points.blocks.size() == 1 &&
-                grid.points.blocks[0].n_points() == motion_.basis(0).size(),
-            who, ": the grid motion was not made for this flow grid (", grid.points.blocks.size(), " blocks, ",
-            grid.points.blocks[0].n_points(), " points vs ", motion_.basis(0).size(), ")");
+    const auto& whole = motion_.rest();
+    if (origins_.empty()) {
+      require(grid.points.blocks.size() == 1 && grid.points.blocks[0].n_points() == whole.n_points(), who,
+              ": the grid motion was not made for this flow grid (", grid.points.blocks.size(), " blocks, ",
+              grid.points.blocks[0].n_points(), " points vs ", whole.n_points(), ")");
+      origins_.resize(1);
+    } else {
+      // a cut grid: each block a box of the motion's grid, point for point
+      require(origins_.size() == grid.points.blocks.size(), who, ": ", origins_.size(), " block origins for ",
+              grid.points.blocks.size(), " blocks");
+      for (std::size_t b = 0; b < origins_.size(); ++b) {
+        const auto& blk = grid.points.blocks[b];
+        const auto& o = origins_[b];
+        bool inside = o.block == 0;
+        for (int d = 0; d < 3; ++d) inside = inside && o.offset[d] >= 0 && o.offset[d] + blk.points[d] <= whole.points[d];
+        require(inside, who, ": block ", b, "'s origin lies outside the grid motion's block");
+        for (std::size_t k = 0; k < blk.n_points(); ++k)
+          require(blk.x[k] == whole.x[motion_point(b, flow::unravel<3>(k, blk.points))], who, ": block ", b,
+                  "'s point ", k, " is not the grid motion's point at its origin");
+      }
+    }
     nf_ = flow_.size();
     m_ = structure_.modes();
     const auto& rest = flow_.metrics();
-    const auto& g = grid.points.blocks[0];
     walls_ = flow_.loaded_faces();
     for (const auto& f : walls_) {
       const auto corners =
@@ -95,7 +115,7 @@ class wing_system {
       for (Eigen::Index i = 0; i < m_; ++i) {
         std::array<double, 3> mean{};
         for (const auto& c : corners) {
-          const auto& psi = motion_.basis(i)[flow::linear_index<3>(c, g.points)];
+          const auto& psi = motion_.basis(i)[motion_point(static_cast<std::size_t>(f.block), c)];
           for (int d = 0; d < 3; ++d) mean[d] += 0.25 * psi[d];
         }
         face_mode_.push_back(mean);
@@ -181,10 +201,44 @@ class wing_system {
   template <class T>
   flow::grid_metrics<T, 3> moved_metrics(const vec<T>& w) const {
     require_size(w.size(), size(), "wing_system::moved_metrics", "state");
+    return moved_metrics_of<T>(vec<T>(w.tail(2 * m_)));
+  }
+  /// The same from the structural part w_s = (a, a') alone (the distributed wing's ranks hold
+  /// only their flow values).
+  template <class T>
+  flow::grid_metrics<T, 3> moved_metrics_of(const vec<T>& ws) const {
     flow::multiblock_points<T, 3> pts, spd;
-    pts.blocks.push_back(motion_.points<T>(w.segment(nf_, m_)));
-    spd.blocks.push_back(motion_.velocities<T>(w.segment(nf_ + m_, m_)));
+    moved_points<T>(ws, pts, spd);
     return flow::compute_metrics<T, 3>(pts, &spd);
+  }
+
+  /// The moved points and their speeds of every block of the flow grid at w_s = (a, a').
+  template <class T>
+  void moved_points(const vec<T>& ws, flow::multiblock_points<T, 3>& pts, flow::multiblock_points<T, 3>& spd) const {
+    require_size(ws.size(), 2 * m_, "wing_system::moved_points", "structural state");
+    auto p = motion_.points<T>(ws.head(m_));
+    auto v = motion_.velocities<T>(ws.tail(m_));
+    pts.blocks.clear();
+    spd.blocks.clear();
+    if (flow_.grid().points.blocks.size() == 1) {
+      pts.blocks.push_back(std::move(p));
+      spd.blocks.push_back(std::move(v));
+      return;
+    }
+    for (std::size_t b = 0; b < origins_.size(); ++b) {
+      const auto& n = flow_.grid().points.blocks[b].points;
+      flow::grid_block<T, 3> pb, vb;
+      pb.points = vb.points = n;
+      pb.x.resize(pb.n_points());
+      vb.x.resize(vb.n_points());
+      for (std::size_t k = 0; k < pb.x.size(); ++k) {
+        const std::size_t q = motion_point(b, flow::unravel<3>(k, n));
+        pb.x[k] = p.x[q];
+        vb.x[k] = v.x[q];
+      }
+      pts.blocks.push_back(std::move(pb));
+      spd.blocks.push_back(std::move(vb));
+    }
   }
 
   /// The flow model on the grid moved to the modal state of w (points and speeds): the
@@ -192,19 +246,22 @@ class wing_system {
   flow::euler_model<3> moved_flow(const vec<double>& w) const {
     require_size(w.size(), size(), "wing_system::moved_flow", "state");
     flow::multiblock_points<double, 3> pts, spd;
-    pts.blocks.push_back(motion_.points<double>(w.segment(nf_, m_)));
-    spd.blocks.push_back(motion_.velocities<double>(w.segment(nf_ + m_, m_)));
+    moved_points<double>(vec<double>(w.tail(2 * m_)), pts, spd);
     flow::euler_model<3> moved = flow_;
     moved.set_grid_motion(pts, &spd);
     return moved;
   }
+
+  /// Where the flow grid's blocks lie in the grid motion's block (one entry, offset 0, when
+  /// the flow grid is that block).
+  const std::vector<flow::block_origin<3>>& block_origins() const { return origins_; }
 
   /// The generalised forces g (m entries, non-dimensional: by rho U^2 c^2 times root chords) of state w.
   template <class T>
   vec<T> generalised_forces(const vec<T>& w) const {
     require_size(w.size(), size(), "wing_system::generalised_forces", "state");
     vec<T> g;
-    with_metrics<T>(w, [&](const flow::grid_metrics<T, 3>& m) { g = forces_on<T>(m, w); });
+    with_metrics<T>(w, [&](const flow::grid_metrics<T, 3>& m) { g = forces_of_blocks<T>(m, w.data(), nullptr); });
     return g;
   }
 
@@ -214,7 +271,7 @@ class wing_system {
     vec<T> r(size());
     with_metrics<T>(w, [&](const flow::grid_metrics<T, 3>& m) {
       flow_.template residual<T>(m, w.data(), r.data());
-      const vec<T> g = forces_on<T>(m, w);
+      const vec<T> g = forces_of_blocks<T>(m, w.data(), nullptr);
       r.tail(2 * m_) = structure_.residual<T>(w.tail(2 * m_), g, mu);
     });
     return r;
@@ -261,11 +318,57 @@ class wing_system {
     return a;
   }
 
+  /// The generalised forces g (m entries) on metrics m of the flow state wf (the whole grid's
+  /// flow values), from the loaded faces of the blocks selected by `blocks` (one entry per
+  /// block; nullptr: all): a sum over faces, so the parts of disjoint selections add up to g.
+  template <class T>
+  vec<T> forces_of_blocks(const flow::grid_metrics<T, 3>& m, const T* wf, const std::vector<char>* blocks) const {
+    const T pinf = T(flow_.conditions().pressure());
+    vec<T> g = vec<T>::Constant(m_, T(0.0));
+    for (std::size_t f = 0; f < walls_.size(); ++f) {
+      const auto& wl = walls_[f];
+      if (blocks && !(*blocks)[static_cast<std::size_t>(wl.block)]) continue;
+      const T dp = T(1.5) * flow::pressure_at<T, 3>(wf + wl.cell0 * nv) - T(0.5) * flow::pressure_at<T, 3>(wf + wl.cell1 * nv) - pinf;
+      for (Eigen::Index i = 0; i < m_; ++i) g[i] += dp * face_work<T>(m, f, i);
+    }
+    return g;
+  }
+
+  /// The entries of dg/dw_f on metrics m at the flow state wf, from the loaded faces of the
+  /// selected blocks (nullptr: all): entry(i, cell, v, x) for each contribution x to
+  /// dg_i / dw_(cell, v) (a cell may receive several; they add up).
+  template <class Entry>
+  void force_pressure_entries(const flow::grid_metrics<double, 3>& m, const double* wf,
+                              const std::vector<char>* blocks, Entry&& entry) const {
+    using cjet = jet<double, nv>;
+    for (std::size_t f = 0; f < walls_.size(); ++f) {
+      const auto& wl = walls_[f];
+      if (blocks && !(*blocks)[static_cast<std::size_t>(wl.block)]) continue;
+      for (int which = 0; which < 2; ++which) {
+        const Eigen::Index cell = which == 0 ? wl.cell0 : wl.cell1;
+        const double weight = which == 0 ? 1.5 : -0.5;
+        std::array<cjet, nv> wc;
+        for (int u = 0; u < nv; ++u) wc[u] = cjet::variable(wf[cell * nv + u], u);
+        const cjet p = flow::pressure_at<cjet, 3>(wc.data());
+        for (Eigen::Index i = 0; i < m_; ++i) {
+          const double c = weight * face_work<double>(m, f, i);
+          for (int v = 0; v < nv; ++v) entry(i, cell, v, c * p.derivative(v));
+        }
+      }
+    }
+  }
+
  private:
   using wall_face = flow::euler_model<3>::loaded_face;
   struct coupling_blocks {
     Eigen::MatrixXd fs, ss;  // [A_fs; A_ss] (nf x 2m, 2m x 2m)
   };
+
+  /// The motion's point index of point i of the flow grid's block b.
+  std::size_t motion_point(std::size_t b, flow::index_d<3> i) const {
+    for (int d = 0; d < 3; ++d) i[d] += origins_[b].offset[d];
+    return flow::linear_index<3>(i, motion_.rest().points);
+  }
 
   /// A double state with the structural part exactly zero: the grid at rest.
   bool at_rest(const vec<double>& w) const { return w.tail(2 * m_).isZero(0.0); }
@@ -297,37 +400,12 @@ class wing_system {
     return T(double(wf.sign)) * (s[0] * psi[0] + s[1] * psi[1] + s[2] * psi[2]);
   }
 
-  template <class T>
-  vec<T> forces_on(const flow::grid_metrics<T, 3>& m, const vec<T>& w) const {
-    const T pinf = T(flow_.conditions().pressure());
-    vec<T> g = vec<T>::Constant(m_, T(0.0));
-    for (std::size_t f = 0; f < walls_.size(); ++f) {
-      const auto& wf = walls_[f];
-      const T dp = T(1.5) * flow::pressure_at<T, 3>(w.data() + wf.cell0 * nv) - T(0.5) * flow::pressure_at<T, 3>(w.data() + wf.cell1 * nv) - pinf;
-      for (Eigen::Index i = 0; i < m_; ++i) g[i] += dp * face_work<T>(m, f, i);
-    }
-    return g;
-  }
-
   /// dg/dw_f (m x nf, non-zero in the wall cells' columns) at the grid of w.
   Eigen::MatrixXd force_pressure_derivative(const vec<double>& w) const {
     Eigen::MatrixXd gf = Eigen::MatrixXd::Zero(m_, nf_);
     with_metrics<double>(w, [&](const flow::grid_metrics<double, 3>& m) {
-    using cjet = jet<double, nv>;
-    for (std::size_t f = 0; f < walls_.size(); ++f) {
-      const auto& wf = walls_[f];
-      for (int which = 0; which < 2; ++which) {
-        const Eigen::Index cell = which == 0 ? wf.cell0 : wf.cell1;
-        const double weight = which == 0 ? 1.5 : -0.5;
-        std::array<cjet, nv> wc;
-        for (int u = 0; u < nv; ++u) wc[u] = cjet::variable(w[cell * nv + u], u);
-        const cjet p = flow::pressure_at<cjet, 3>(wc.data());
-        for (Eigen::Index i = 0; i < m_; ++i) {
-          const double c = weight * face_work<double>(m, f, i);
-          for (int v = 0; v < nv; ++v) gf(i, cell * nv + v) += c * p.derivative(v);
-        }
-      }
-    }
+      force_pressure_entries(m, w.data(), nullptr,
+                             [&](Eigen::Index i, Eigen::Index cell, int v, double x) { gf(i, cell * nv + v) += x; });
     });
     return gf;
   }
@@ -340,7 +418,7 @@ class wing_system {
       const Eigen::Index width = std::min<Eigen::Index>(jet_width, m_ - j0);
       vec<sjet> wj = w.cast<sjet>();
       for (Eigen::Index j = 0; j < width; ++j) wj[nf_ + j0 + j] = sjet::variable(w[nf_ + j0 + j], static_cast<int>(j));
-      const vec<sjet> g = forces_on<sjet>(moved_metrics<sjet>(wj), wj);
+      const vec<sjet> g = forces_of_blocks<sjet>(moved_metrics<sjet>(wj), wj.data(), nullptr);
       for (Eigen::Index j = 0; j < width; ++j)
         for (Eigen::Index i = 0; i < m_; ++i) ga(i, j0 + j) = g[i].derivative(static_cast<int>(j));
     }
@@ -362,7 +440,7 @@ class wing_system {
       const auto m = moved_metrics<sjet>(wj);
       vec<sjet> r(size());
       flow_.template residual<sjet>(m, wj.data(), r.data());
-      const vec<sjet> g = forces_on<sjet>(m, wj);
+      const vec<sjet> g = forces_of_blocks<sjet>(m, wj.data(), nullptr);
       r.tail(ns) = structure_.residual<sjet>(wj.tail(ns), g, sjet(mu));
       for (Eigen::Index j = 0; j < width; ++j) {
         const int d = static_cast<int>(j);
@@ -402,8 +480,24 @@ class wing_system {
   coupling::wing_modal_motion motion_;
   structure::modal_structure structure_;
   Eigen::Index nf_ = 0, m_ = 0;
+  std::vector<flow::block_origin<3>> origins_;   // per flow block: its box in the motion's block
   std::vector<wall_face> walls_;
   std::vector<std::array<double, 3>> face_mode_;  // Psi_i(f), face-major
 };
+
+/// The wing system `s` on its grid cut into blocks (`cut`: flow::split_block or
+/// distributed::split_for_ranks of s.flow().grid(), which record where the blocks' points lie):
+/// the same free stream, options, motion and structure. Its state orders the flow cells as
+/// cut.original_cell; the residual and Jacobian are s's so permuted (the loads summed in another
+/// order: to rounding).
+inline wing_system split_wing_system(const wing_system& s, const flow::split_grid<3>& cut) {
+  const char* who = "split_wing_system";
+  require(s.flow().grid().points.blocks.size() == 1, who, ": the system's grid is cut already (",
+          s.flow().grid().points.blocks.size(), " blocks)");
+  require(!cut.origin.empty(), who, ": the cut grid does not record where its blocks' points lie (split_grid::origin)");
+  require_size(cut.original_cell.size(), static_cast<std::size_t>(s.flow().n_cells()), who, "cut grid's cells");
+  return wing_system(flow::euler_model<3>(cut.grid, s.flow().conditions(), s.flow().options()), s.motion(),
+                     s.structure(), cut.origin);
+}
 
 }  // namespace aerohopf::models

@@ -1,0 +1,177 @@
+#pragma once
+// The flexible wing's flutter_family (models/wing_family.hpp) with its heavy solves on the ranks
+// of an MPI communicator, so that trace_flutter_boundary (run alike on every rank) computes the
+// serial boundary with the work split, as distributed::aerofoil_family does for the aerofoil:
+//  * each solve cuts the level's one-block grid for the ranks (split_for_ranks: as many blocks
+//    as ranks where the longest axis divides so) and builds the wing system on the cut grid
+//    (models::split_wing_system, distributed_wing): the same cells in another order;
+//  * equilibrium: the steady flow about the wing at rest by flow::solve_steady on the ranks
+//    (distributed_euler_discretisation, block-Jacobi BILU), gathered, its generalised forces
+//    checked as wing_system::steady_equilibrium does;
+//  * hopf_start: distributed::inverse_power at (w, mu), shift i omega (the driver's
+//    hopf_start_krylov options);
+//  * solve_hopf: distributed::solve_hopf (fixed equilibrium: the wing family's only formulation)
+//    with the driver's Newton options, BILU fill, GMRES restart, forcing bound and start
+//    refinement.
+// Vectors cross this interface whole and in the serial system's cell order (to_split_order and
+// back), all-gathered, so the driver runs on every rank on the same numbers and takes the same
+// decisions. The grid, its metrics and the systems are replicated on every rank (the memory
+// note of mpi_euler.hpp); the cut system is rebuilt per call (its metrics: a small part of a
+// Hopf solve).
+#include <mpi.h>
+
+#include <aerohopf/bifurcation/flutter_boundary.hpp>
+#include <aerohopf/bifurcation/hopf_bordered.hpp>
+#include <aerohopf/distributed/mpi_hopf.hpp>
+#include <aerohopf/distributed/mpi_steady.hpp>
+#include <aerohopf/distributed/mpi_wing.hpp>
+#include <aerohopf/distributed/partition.hpp>
+#include <aerohopf/models/wing_family.hpp>
+
+#include <cmath>
+#include <complex>
+#include <optional>
+#include <string>
+#include <utility>
+
+namespace aerohopf::distributed {
+
+/// A wing system cut for the ranks of comm, and its distributed evaluation; vectors to and from
+/// the serial system's order. Collective construction; `s` must outlive it.
+class wing_on_ranks {
+ public:
+  static constexpr int nv = models::wing_system::nv;
+  wing_on_ranks(const models::wing_system& s, MPI_Comm comm)
+      : cut_(split_for_ranks(s.flow().grid(), size_of(comm))),
+        sys_(models::split_wing_system(s, cut_)),
+        d_(sys_, partition_blocks(sys_.flow(), size_of(comm)), comm) {}
+
+  distributed_wing& d() { return d_; }
+  const flow::split_grid<3>& cut() const { return cut_; }
+  const models::wing_system& system() const { return sys_; }
+  /// This rank's part of a whole vector of the serial system (real or complex).
+  template <class S>
+  vec<S> local(const vec<S>& whole) const {
+    return d_.local_part(flow::to_split_order(cut_, whole, nv));
+  }
+  /// The whole vector, in the serial system's order, from every rank's part (collective).
+  template <class S>
+  vec<S> whole(const vec<S>& local) {
+    return flow::from_split_order(cut_, d_.all_gather(local), nv);
+  }
+
+ private:
+  static int size_of(MPI_Comm comm) {
+    int n = 0;
+    internal::check_mpi(MPI_Comm_size(comm, &n), "MPI_Comm_size");
+    return n;
+  }
+  flow::split_grid<3> cut_;
+  models::wing_system sys_;
+  distributed_wing d_;
+};
+
+class wing_family {
+ public:
+  using system_type = models::wing_system;
+  static constexpr int block_size = models::wing_family::block_size;
+
+  /// serial: the family (the same on every rank); comm: its ranks. Collective: every rank must
+  /// construct it.
+  wing_family(models::wing_family serial, MPI_Comm comm) : serial_(std::move(serial)), comm_(comm) {
+    internal::check_mpi(MPI_Comm_size(comm_, &ranks_), "MPI_Comm_size");
+    internal::check_mpi(MPI_Comm_rank(comm_, &rank_), "MPI_Comm_rank");
+  }
+
+  system_type system(int stride, double mach) const { return serial_.system(stride, mach); }
+  static std::string level_name(int stride) { return models::wing_family::level_name(stride); }
+  bool fixed_equilibrium() const { return serial_.fixed_equilibrium(); }
+
+  /// The steady flow about the wing at rest on the ranks, whole on every rank (the same for every
+  /// mu); convergence_error (every rank) if it does not converge or does work on the modes at
+  /// rest (largest generalised force above max_load), as wing_system::steady_equilibrium.
+  vec<double> equilibrium(const system_type& s, double /*mu*/) const {
+    wing_on_ranks r(s, comm_);
+    flow::euler_model<3> m = r.system().flow();
+    distributed_euler<3> d(m, partition_blocks(m, ranks_), comm_);
+    distributed_euler_discretisation<3> disc(m, d);
+    vec<double> wf = d.local_part(m.free_stream_vector());
+    const auto rep = flow::solve_steady(disc, wf, serial_.steady_options());
+    const double mach = s.flow().conditions().mach;
+    if (!rep.converged)
+      throw convergence_error(aerohopf::internal::concat(
+          "distributed::wing_family: the steady flow at M = ", mach, " on ", ranks_, " ranks did not converge (",
+          rep.steps, " steps, residual ", rep.final_residual, ": ", rep.reason, ")"));
+    vec<double> w = s.free_stream_state();
+    w.head(s.flow_size()) = d.all_gather(wf);
+    w = flow::from_split_order(r.cut(), w, wing_on_ranks::nv);
+    const double g = s.generalised_forces<double>(w).cwiseAbs().maxCoeff();
+    if (!(g <= max_load))
+      throw convergence_error(aerohopf::internal::concat(
+          "distributed::wing_family: the steady flow at M = ", mach, " does work on the modes at rest (largest "
+          "generalised force ", g, ", limit ", max_load, "): not an equilibrium of the coupled system"));
+    return w;
+  }
+  vec<double> equilibrium_from(const system_type& s, const vec<double>& w0, double mu0, double mu) const {
+    return serial_.equilibrium_from(s, w0, mu0, mu);
+  }
+
+  /// The eigenpair of J(w, mu) nearest i omega by inverse power on the ranks, as a Hopf start
+  /// (as hopf_start_krylov: omega > 0, the vector's phase normalised; info: the eigenpair with
+  /// its iteration and GMRES counts, the vector whole).
+  hopf_point hopf_start(const system_type& s, const vec<double>& w, double mu, double omega,
+                        const hopf_start_krylov_options& so, eigen_pair* info) const {
+    wing_on_ranks r(s, comm_);
+    distributed_wing::jacobian_rows a, p;
+    r.d().jacobians(r.local(w), mu, a, p);
+    const distributed_inverse_power_options io = internal::inverse_power_options_from(so);
+    eigen_pair ep = inverse_power(r.d(), a, so.precondition_exact ? nullptr : &p, {0.0, omega}, io);
+    ep.vector = r.whole(ep.vector);
+    aerohopf::internal::normalise_phase(ep.vector);
+    if (info) *info = ep;
+    return aerohopf::internal::hopf_point_from(w, mu, ep);
+  }
+
+  /// The Hopf point from `guess` on the ranks (fixed equilibrium), whole on every rank; failures
+  /// as distributed::solve_hopf (convergence_error on every rank).
+  hopf_result solve_hopf(const system_type& s, const hopf_point& guess, const hopf_options& ho,
+                         const hopf_krylov_options& ko) const {
+    wing_on_ranks r(s, comm_);
+    const distributed_hopf_point g{r.local(guess.w), guess.mu, guess.omega, r.local(guess.p)};
+    const distributed_hopf_result res = distributed::solve_hopf(r.d(), g, internal::hopf_options_from(ho, ko));
+    vec<std::complex<double>> p = r.whole(res.point.p);  // collective calls in one order
+    vec<double> w = ho.fixed_equilibrium ? guess.w : r.whole(res.point.w);  // fixed: w unchanged
+    return internal::hopf_result_from(res, std::move(w), std::move(p));
+  }
+
+  flutter_boundary_options boundary_options() const { return serial_.boundary_options(); }
+  bool refines(int coarse_stride, int fine_stride) const { return serial_.refines(coarse_stride, fine_stride); }
+  std::optional<int> coarser_level(int stride) const { return serial_.coarser_level(stride); }
+  vec<std::complex<double>> prolong(const system_type& fine, const system_type& coarse,
+                                    const vec<std::complex<double>>& p) const {
+    return serial_.prolong(fine, coarse, p);
+  }
+  vec<std::complex<double>> structure_part(const vec<std::complex<double>>& p) const {
+    return serial_.structure_part(p);
+  }
+  static double stiffness_factor(double mu) { return models::wing_family::stiffness_factor(mu); }
+  static double parameter_of_factor(double q) { return models::wing_family::parameter_of_factor(q); }
+
+  const models::wing_family& serial() const { return serial_; }
+  MPI_Comm communicator() const { return comm_; }
+  int ranks() const { return ranks_; }
+  int rank() const { return rank_; }
+
+  /// Largest generalised force of the steady flow about the wing at rest for an equilibrium (as
+  /// wing_system::steady_equilibrium's default).
+  static constexpr double max_load = 1e-8;
+
+ private:
+  models::wing_family serial_;
+  MPI_Comm comm_;
+  int ranks_ = 1, rank_ = 0;
+};
+
+static_assert(flutter_family<wing_family>);
+
+}  // namespace aerohopf::distributed
