@@ -81,7 +81,7 @@ block_partition partition_blocks(const flow::euler_model<Dim>& m, int ranks) {
 
 /// A grid whose blocks whole-block partitioning can spread over `ranks` ranks within
 /// `max_imbalance` (largest rank's cells over the mean): the largest block is cut along its
-/// longest axis (flow::split_block), one rank's share (total cells / ranks) off it where it holds
+/// longest axis (or along `axis` while it has 4 cells or more; flow::split_block), one rank's share (total cells / ranks) off it where it holds
 /// more than that, else in half, until partition_blocks reaches the bound, or the largest block
 /// has fewer than 4 cells along every axis (then the grid so far is returned; check
 /// partition_blocks(...).imbalance()). A single-block wing grid becomes `ranks` blocks of equal
@@ -89,9 +89,11 @@ block_partition partition_blocks(const flow::euler_model<Dim>& m, int ranks) {
 /// alone made 17).
 /// original_cell maps the result's cells to g's, origin its blocks' points to g's.
 template <int Dim>
-flow::split_grid<Dim> split_for_ranks(const flow::multiblock_grid<Dim>& g, int ranks, double max_imbalance = 1.1) {
+flow::split_grid<Dim> split_for_ranks(const flow::multiblock_grid<Dim>& g, int ranks, double max_imbalance = 1.1,
+                                      int axis = -1) {
   require(ranks >= 1, "split_for_ranks: ", ranks, " ranks (at least 1)");
   require(max_imbalance >= 1.0, "split_for_ranks: max_imbalance ", max_imbalance, " (at least 1)");
+  require(axis >= -1 && axis < Dim, "split_for_ranks: axis ", axis, " (-1: the longest, or 0 .. ", Dim - 1, ")");
   flow::split_grid<Dim> cur{g, {}};
   std::size_t total = 0;
   for (const auto& c : g.topology.cells) total += flow::product<Dim>(c);
@@ -105,14 +107,15 @@ flow::split_grid<Dim> split_for_ranks(const flow::multiblock_grid<Dim>& g, int r
     for (std::size_t b = 0; b < n.size(); ++b) n[b] = flow::product<Dim>(cells[b]);
     if (n.size() >= static_cast<std::size_t>(ranks) && partition_blocks(n, ranks).imbalance() <= max_imbalance) break;
     const int big = static_cast<int>(std::max_element(n.begin(), n.end()) - n.begin());
-    const int axis = static_cast<int>(std::max_element(cells[big].begin(), cells[big].end()) - cells[big].begin());
-    const int len = cells[big][axis];
+    const int longest = static_cast<int>(std::max_element(cells[big].begin(), cells[big].end()) - cells[big].begin());
+    const int cut = axis >= 0 && cells[big][axis] >= 4 ? axis : longest;
+    const int len = cells[big][cut];
     if (len < 4) break;
     const double share = static_cast<double>(total) / ranks;
     int at = len / 2;
     if (static_cast<double>(n[big]) > 1.5 * share)
       at = std::clamp(static_cast<int>(std::lround(len * share / static_cast<double>(n[big]))), 2, len - 2);
-    auto next = flow::split_block(cur.grid, big, axis, at);
+    auto next = flow::split_block(cur.grid, big, cut, at);
     for (auto& c : next.original_cell) c = cur.original_cell[c];
     next.origin = flow::compose_origins(cur.origin, next.origin);
     cur = std::move(next);
