@@ -259,6 +259,23 @@ std::vector<boundary_run> boundaries(const flutter_options& o, const std::filesy
   return runs;
 }
 
+/// costs.csv: level,damping_percent,quantity,value (the Hopf work per steady solve of each
+/// boundary, its mean steady solve and its wall time, seconds).
+inline void write_costs(const std::filesystem::path& file, const std::vector<boundary_run>& runs,
+                        const std::vector<double>& machs) {
+  csv_writer costs(file, "level,damping_percent,quantity,value");
+  for (const auto& r : runs) {
+    const flutter_boundary_costs c = boundary_costs(r.b, machs);
+    const std::string level = models::wing_family::level_name(r.stride);
+    double steady_mean = 0;
+    for (const auto& p : r.b.points) steady_mean += p.steady_seconds / double(r.b.points.size());
+    costs.row({level, r.damping, "hopf_per_steady_continued", c.hopf_per_steady});
+    costs.row({level, r.damping, "hopf_per_steady_listed", c.hopf_per_steady_listed});
+    costs.row({level, r.damping, "steady_seconds_mean", steady_mean});
+    costs.row({level, r.damping, "boundary_seconds", r.seconds});
+  }
+}
+
 /// The Hopf point of one family member from the experiment's start (inverse power to 1e-3 as
 /// the driver's first point, then Newton-Krylov), with the system and its equilibrium.
 struct single_point {

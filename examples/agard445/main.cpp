@@ -255,17 +255,7 @@ int main(int argc, char** argv) try {
       const auto runs = agard445_flutter::boundaries(
           o.flutter, o.out, w, go, four, [](const models::wing_family& f) -> const models::wing_family& { return f; }, [](auto&& fn) { fn(); },
           &std::cout);
-      csv_writer costs(o.out / "costs.csv", "level,damping_percent,quantity,value");
-      for (const auto& r : runs) {
-        const flutter_boundary_costs c = boundary_costs(r.b, o.flutter.machs);
-        const std::string level = models::wing_family::level_name(r.stride);
-        double steady_mean = 0;
-        for (const auto& p : r.b.points) steady_mean += p.steady_seconds / double(r.b.points.size());
-        costs.row({level, r.damping, "hopf_per_steady_continued", c.hopf_per_steady});
-        costs.row({level, r.damping, "hopf_per_steady_listed", c.hopf_per_steady_listed});
-        costs.row({level, r.damping, "steady_seconds_mean", steady_mean});
-        costs.row({level, r.damping, "boundary_seconds", r.seconds});
-      }
+      agard445_flutter::write_costs(o.out / "costs.csv", runs, o.flutter.machs);
     }
     if (o.flutter.vg_stride) agard445_flutter::vg(o.flutter, o.out, w, go, four);
     if (o.flutter.march_stride) agard445_flutter::march(o.flutter, o.flutter.march_stride, o.out, w, go, four);

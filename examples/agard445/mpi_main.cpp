@@ -11,7 +11,7 @@
 //                     as agard445's (default: coarse and medium, 0, 0.5 and 2 % on coarse, 0.5 % on
 //                     medium, the experiment's four Mach numbers; plate mesh 24 x 24)
 // Outputs under out_dir (default out/agard445_mpi): boundary_<level>_zeta<percent>.csv in the
-// serial program's format, flutter_mode_*_M0.96_phase<k>.vtk and costs.csv (with the ranks).
+// serial program's format, flutter_mode_*_M0.96_phase<k>.vtk and costs.csv.
 // Exit status 1 if a boundary is incomplete.
 #include <mpi.h>
 
@@ -79,18 +79,7 @@ int run(int argc, char** argv, int rank, int ranks) {
   int incomplete = 0;
   for (const auto& r : runs) incomplete += r.b.complete ? 0 : 1;
   output([&] {
-    csv_writer costs(o.out / "costs.csv", "level,damping_percent,ranks,quantity,value");
-    for (const auto& r : runs) {
-      const flutter_boundary_costs c = boundary_costs(r.b, o.flutter.machs);
-      const std::string level = models::wing_family::level_name(r.stride);
-      double steady_mean = 0;
-      for (const auto& p : r.b.points) steady_mean += p.steady_seconds / double(r.b.points.size());
-      const auto n = static_cast<long long>(ranks);
-      costs.row({level, r.damping, n, "hopf_per_steady_continued", c.hopf_per_steady});
-      costs.row({level, r.damping, n, "hopf_per_steady_listed", c.hopf_per_steady_listed});
-      costs.row({level, r.damping, n, "steady_seconds_mean", steady_mean});
-      costs.row({level, r.damping, n, "boundary_seconds", r.seconds});
-    }
+    agard445_flutter::write_costs(o.out / "costs.csv", runs, o.flutter.machs);
     std::printf("\ntotal %.1f s on %d ranks; results in %s\n",
                 std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(), ranks,
                 o.out.string().c_str());

@@ -42,19 +42,8 @@ models::wing_family serial_family() {
                              test_support::agard_plate_modes(), Eigen::VectorXd::Zero(1), s);
 }
 
-int rank() {
-  int r = 0;
-  MPI_Comm_rank(MPI_COMM_WORLD, &r);
-  return r;
-}
-
-/// The same value on every rank (bitwise).
-bool same_on_every_rank(double x) {
-  double lo = 0, hi = 0;
-  MPI_Allreduce(&x, &lo, 1, MPI_DOUBLE, MPI_MIN, MPI_COMM_WORLD);
-  MPI_Allreduce(&x, &hi, 1, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD);
-  return lo == hi;
-}
+int rank() { return test::world_rank(); }
+using test::same_on_every_rank;
 
 }  // namespace
 

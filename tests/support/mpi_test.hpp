@@ -13,6 +13,20 @@ inline int world_size() {
   return n;
 }
 
+inline int world_rank() {
+  int r = 0;
+  MPI_Comm_rank(MPI_COMM_WORLD, &r);
+  return r;
+}
+
+/// Whether x is the same on every rank (bitwise).
+inline bool same_on_every_rank(double x) {
+  double lo = 0, hi = 0;
+  MPI_Allreduce(&x, &lo, 1, MPI_DOUBLE, MPI_MIN, MPI_COMM_WORLD);
+  MPI_Allreduce(&x, &hi, 1, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD);
+  return lo == hi;
+}
+
 /// MPI_Init, then init() (e.g. PetscInitialize), the tests, fini(), MPI_Finalize; returns
 /// nonzero on every rank if any rank had a failure.
 template <class Init, class Fini>

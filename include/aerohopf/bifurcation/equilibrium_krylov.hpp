@@ -64,13 +64,7 @@ struct equilibrium_krylov_options {
     return o;
   }();
   double eta_max = 1e-2;  ///< largest GMRES relative tolerance (the forcing of the file comment)
-  krylov_options krylov = [] {
-    krylov_options o;
-    o.max_iterations = 2000;
-    o.restart = 80;
-    o.record_history = false;
-    return o;
-  }();  ///< GMRES of the Newton corrections (relative_tolerance is set by the forcing)
+  krylov_options krylov = newton_correction_krylov_options();  ///< GMRES of the Newton corrections (relative_tolerance is set by the forcing)
 };
 
 struct equilibrium_krylov_result {

@@ -182,11 +182,8 @@ void krylov_matrices(const S& sys, const vec<double>& w, double mu, bool precond
 struct hopf_krylov_options {
   int fill_level = 0;               ///< k of the complex BILU(k) of L - i omega I
   krylov_options krylov = [] {
-    krylov_options o;
+    krylov_options o = newton_correction_krylov_options();
     o.relative_tolerance = 1e-6;    ///< of each Newton correction, unless adaptive (below)
-    o.max_iterations = 2000;
-    o.restart = 80;
-    o.record_history = false;
     // Gram-Schmidt once: the corrections are solved only to eta_k <= 1e-2 and the Newton residual
     // is exact, so the second pass over the basis buys nothing (measured on the NACA 0012 medium
     // grid, heavy case, M 0.55-0.75: identical GMRES and Newton counts, GMRES time -12 to -20 %)
@@ -732,11 +729,8 @@ struct hopf_start_krylov_options {
   /// GMRES of each inverse iteration: the solves must be tighter than the eigen-residual target
   /// (inexact inverse iteration with a fixed tolerance stagnates near it, inverse_power.hpp).
   krylov_options krylov = [] {
-    krylov_options o;
+    krylov_options o = newton_correction_krylov_options();
     o.relative_tolerance = 1e-9;
-    o.max_iterations = 2000;
-    o.restart = 80;
-    o.record_history = false;
     return o;
   }();
   /// Tolerance and iteration limit of the inverse iteration (a start for the Hopf Newton

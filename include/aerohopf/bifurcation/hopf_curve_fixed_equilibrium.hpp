@@ -184,11 +184,8 @@ struct fixed_equilibrium_hopf_curve_result : hopf_curve_result {
 struct fixed_equilibrium_hopf_curve_options {
   int fill_level = 1;  ///< k of the complex BILU(k) of L - i omega I and of the real BILU(k) of L
   krylov_options krylov = [] {
-    krylov_options o;
+    krylov_options o = newton_correction_krylov_options();
     o.relative_tolerance = 1e-6;  ///< when not adaptive
-    o.max_iterations = 2000;
-    o.restart = 80;
-    o.record_history = false;
     return o;
   }();
   bool adaptive_tolerance = true;   ///< inexact-Newton forcing (file comment)

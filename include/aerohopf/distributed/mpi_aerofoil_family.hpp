@@ -26,6 +26,7 @@
 #include <aerohopf/bifurcation/flutter_boundary.hpp>
 #include <aerohopf/bifurcation/hopf_bordered.hpp>
 #include <aerohopf/distributed/mpi_aerofoil.hpp>
+#include <aerohopf/distributed/mpi_family.hpp>
 #include <aerohopf/distributed/mpi_hopf.hpp>
 #include <aerohopf/distributed/mpi_steady.hpp>
 #include <aerohopf/distributed/partition.hpp>
@@ -39,21 +40,11 @@
 
 namespace aerohopf::distributed {
 
-class aerofoil_family {
+class aerofoil_family : public distributed_family_base<models::aerofoil_family> {
  public:
-  using system_type = models::aerofoil_system;
-  static constexpr int block_size = models::aerofoil_family::block_size;
-
   /// serial: the family (the same on every rank); comm: its ranks (1 to 3, the C-grid's blocks).
   /// Collective: every rank must construct it.
-  aerofoil_family(models::aerofoil_family serial, MPI_Comm comm) : serial_(std::move(serial)), comm_(comm) {
-    internal::check_mpi(MPI_Comm_size(comm_, &ranks_), "MPI_Comm_size");
-    internal::check_mpi(MPI_Comm_rank(comm_, &rank_), "MPI_Comm_rank");
-  }
-
-  system_type system(int stride, double mach) const { return serial_.system(stride, mach); }
-  static std::string level_name(int stride) { return models::aerofoil_family::level_name(stride); }
-  bool fixed_equilibrium() const { return serial_.fixed_equilibrium(); }
+  aerofoil_family(models::aerofoil_family serial, MPI_Comm comm) : distributed_family_base(std::move(serial), comm) {}
 
   /// The equilibrium of s at Ubar on the ranks, whole on every rank: at zero incidence the steady
   /// flow about the section at rest (the same for every Ubar; convergence_error as
@@ -149,32 +140,9 @@ class aerofoil_family {
     return internal::hopf_result_from(r, std::move(w), std::move(p));
   }
 
-  flutter_boundary_options boundary_options() const { return serial_.boundary_options(); }
-  bool refines(int coarse_stride, int fine_stride) const { return serial_.refines(coarse_stride, fine_stride); }
-  std::optional<int> coarser_level(int stride) const { return serial_.coarser_level(stride); }
-  vec<std::complex<double>> prolong(const system_type& fine, const system_type& coarse,
-                                    const vec<std::complex<double>>& p) const {
-    return serial_.prolong(fine, coarse, p);
-  }
-  vec<std::complex<double>> structure_part(const vec<std::complex<double>>& p) const {
-    return serial_.structure_part(p);
-  }
-  static double stiffness_factor(double ubar) { return models::aerofoil_family::stiffness_factor(ubar); }
-  static double parameter_of_factor(double q) { return models::aerofoil_family::parameter_of_factor(q); }
-
-  const models::aerofoil_family& serial() const { return serial_; }
-  MPI_Comm communicator() const { return comm_; }
-  int ranks() const { return ranks_; }
-  int rank() const { return rank_; }
-
   /// |C_l|, |C_m| above which the steady flow about the section at rest is no equilibrium (as
   /// aerofoil_system::steady_equilibrium's default).
   static constexpr double max_load = 1e-6;
-
- private:
-  models::aerofoil_family serial_;
-  MPI_Comm comm_;
-  int ranks_ = 1, rank_ = 0;
 };
 
 static_assert(flutter_family<aerofoil_family>);

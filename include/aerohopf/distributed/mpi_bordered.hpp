@@ -374,13 +374,7 @@ struct distributed_equilibrium_options {
   double tolerance = 1e-10;     ///< ||f(w, mu)||_2 over the ranks
   int max_iterations = 25;      ///< full Newton steps
   double eta_max = 1e-2;        ///< GMRES forcing eta_k = min(eta_max, max(||f_k||, 0.1 tolerance / ||f_k||))
-  krylov_options krylov = [] {
-    krylov_options o;
-    o.max_iterations = 2000;
-    o.restart = 80;
-    o.record_history = false;
-    return o;
-  }();
+  krylov_options krylov = newton_correction_krylov_options();
 };
 
 struct distributed_equilibrium_result {

@@ -77,13 +77,7 @@ struct distributed_hopf_options {
   int fill_level = 0;  ///< k of the block-Jacobi BILU(k)
   /// GMRES of each correction: relative tolerance eta_k = min(eta_max, max(||F_k||, 0.1
   /// abs_tolerance / ||F_k||)) (inexact Newton, quadratic), restart and iteration limit.
-  krylov_options krylov = [] {
-    krylov_options o;
-    o.max_iterations = 2000;
-    o.restart = 80;
-    o.record_history = false;
-    return o;
-  }();
+  krylov_options krylov = newton_correction_krylov_options();
   double eta_max = 1e-2;
   /// Start refinement (fixed formulation; as hopf_krylov_options): where ||F(guess)|| >
   /// start_residual_threshold, start_iterations inverse iterations at i omega from the guess's p

@@ -23,6 +23,7 @@
 
 #include <aerohopf/bifurcation/flutter_boundary.hpp>
 #include <aerohopf/bifurcation/hopf_bordered.hpp>
+#include <aerohopf/distributed/mpi_family.hpp>
 #include <aerohopf/distributed/mpi_hopf.hpp>
 #include <aerohopf/distributed/mpi_steady.hpp>
 #include <aerohopf/distributed/mpi_wing.hpp>
@@ -78,23 +79,12 @@ class wing_on_ranks {
   distributed_wing d_;
 };
 
-class wing_family {
+class wing_family : public distributed_family_base<models::wing_family> {
  public:
-  using system_type = models::wing_system;
-  static constexpr int block_size = models::wing_family::block_size;
-
-  /// serial: the family (the same on every rank); comm: its ranks. Collective: every rank must
-  /// construct it.
-  /// cut_axis: as wing_on_ranks's.
+  /// serial: the family (the same on every rank); comm: its ranks; cut_axis: as wing_on_ranks's.
+  /// Collective: every rank must construct it.
   wing_family(models::wing_family serial, MPI_Comm comm, int cut_axis = wing_on_ranks::normal_axis)
-      : serial_(std::move(serial)), comm_(comm), cut_axis_(cut_axis) {
-    internal::check_mpi(MPI_Comm_size(comm_, &ranks_), "MPI_Comm_size");
-    internal::check_mpi(MPI_Comm_rank(comm_, &rank_), "MPI_Comm_rank");
-  }
-
-  system_type system(int stride, double mach) const { return serial_.system(stride, mach); }
-  static std::string level_name(int stride) { return models::wing_family::level_name(stride); }
-  bool fixed_equilibrium() const { return serial_.fixed_equilibrium(); }
+      : distributed_family_base(std::move(serial), comm), cut_axis_(cut_axis) {}
 
   /// The steady flow about the wing at rest on the ranks, whole on every rank (the same for every
   /// mu); convergence_error (every rank) if it does not converge or does work on the modes at
@@ -153,33 +143,12 @@ class wing_family {
     return internal::hopf_result_from(res, std::move(w), std::move(p));
   }
 
-  flutter_boundary_options boundary_options() const { return serial_.boundary_options(); }
-  bool refines(int coarse_stride, int fine_stride) const { return serial_.refines(coarse_stride, fine_stride); }
-  std::optional<int> coarser_level(int stride) const { return serial_.coarser_level(stride); }
-  vec<std::complex<double>> prolong(const system_type& fine, const system_type& coarse,
-                                    const vec<std::complex<double>>& p) const {
-    return serial_.prolong(fine, coarse, p);
-  }
-  vec<std::complex<double>> structure_part(const vec<std::complex<double>>& p) const {
-    return serial_.structure_part(p);
-  }
-  static double stiffness_factor(double mu) { return models::wing_family::stiffness_factor(mu); }
-  static double parameter_of_factor(double q) { return models::wing_family::parameter_of_factor(q); }
-
-  const models::wing_family& serial() const { return serial_; }
-  MPI_Comm communicator() const { return comm_; }
-  int ranks() const { return ranks_; }
-  int rank() const { return rank_; }
-
   /// Largest generalised force of the steady flow about the wing at rest for an equilibrium (as
   /// wing_system::steady_equilibrium's default).
   static constexpr double max_load = 1e-8;
 
  private:
-  models::wing_family serial_;
-  MPI_Comm comm_;
   int cut_axis_;
-  int ranks_ = 1, rank_ = 0;
 };
 
 static_assert(flutter_family<wing_family>);

@@ -65,6 +65,17 @@ struct krylov_options {
   double reorthogonalization_threshold = 0.70710678118654752;
 };
 
+/// The GMRES options of inexact Newton corrections (the steady, equilibrium and Hopf Newton
+/// solvers): GMRES(80), at most 2000 iterations, no history kept; the relative tolerance is the
+/// caller's forcing. GMRES(50) stagnated on the AGARD coarse grid where GMRES(80) converged.
+inline krylov_options newton_correction_krylov_options() {
+  krylov_options o;
+  o.max_iterations = 2000;
+  o.restart = 80;
+  o.record_history = false;
+  return o;
+}
+
 struct krylov_report {
   std::string method;
   bool converged = false;
