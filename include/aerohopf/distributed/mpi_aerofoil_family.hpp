@@ -91,18 +91,10 @@ class aerofoil_family : public distributed_family_base<models::aerofoil_family> 
   /// structure at rest; check_loads: convergence_error if it loads the section (|C_l| or |C_m| >
   /// max_load: then it is no equilibrium of the coupled system).
   vec<double> steady_flow(const system_type& s, bool check_loads) const {
-    flow::euler_model<2> m = s.flow();
-    distributed_euler<2> d(m, partition_blocks(m, ranks_), comm_);
-    distributed_euler_discretisation<2> disc(m, d);
-    vec<double> wf = d.local_part(m.free_stream_vector());
-    const auto r = flow::solve_steady(disc, wf, serial_.steady_options());
-    const double mach = s.flow().conditions().mach;
-    if (!r.converged)
-      throw convergence_error(aerohopf::internal::concat(
-          "distributed::aerofoil_family: the steady flow at M = ", mach, " on ", ranks_, " ranks did not converge (",
-          r.steps, " steps, residual ", r.final_residual, ": ", r.reason, ")"));
     vec<double> w = s.free_stream_state();
-    w.head(s.flow_size()) = d.all_gather(wf);
+    w.head(s.flow_size()) =
+        steady_flow_on_ranks(s.flow(), comm_, serial_.steady_options(), "distributed::aerofoil_family");
+    const double mach = s.flow().conditions().mach;
     if (!check_loads) return w;
     const auto [cl, cm] = s.load_coefficients<double>(w);
     if (!(std::abs(cl) <= max_load && std::abs(cm) <= max_load))

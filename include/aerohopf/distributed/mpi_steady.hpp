@@ -133,4 +133,25 @@ class distributed_euler_discretisation {
   matrix own_;
 };
 
+/// The steady flow of `model` from the free stream on the ranks of comm (its blocks partitioned
+/// by partition_blocks: the grid must have at least as many blocks as ranks), whole on every rank
+/// in the model's cell order; convergence_error (every rank) naming `who`, the Mach number and
+/// the ranks if it does not converge. The distributed flutter families' equilibria.
+template <int Dim>
+vec<double> steady_flow_on_ranks(const flow::euler_model<Dim>& model, MPI_Comm comm, const flow::steady_options& o,
+                                 const char* who) {
+  int ranks = 0;
+  internal::check_mpi(MPI_Comm_size(comm, &ranks), "MPI_Comm_size");
+  flow::euler_model<Dim> m = model;
+  distributed_euler<Dim> d(m, partition_blocks(m, ranks), comm);
+  distributed_euler_discretisation<Dim> disc(m, d);
+  vec<double> wf = d.local_part(m.free_stream_vector());
+  const auto r = flow::solve_steady(disc, wf, o);
+  if (!r.converged)
+    throw convergence_error(aerohopf::internal::concat(who, ": the steady flow at M = ", model.conditions().mach,
+                                                       " on ", ranks, " ranks did not converge (", r.steps,
+                                                       " steps, residual ", r.final_residual, ": ", r.reason, ")"));
+  return d.all_gather(wf);
+}
+
 }  // namespace aerohopf::distributed

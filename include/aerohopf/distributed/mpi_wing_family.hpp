@@ -90,20 +90,12 @@ class wing_family : public distributed_family_base<models::wing_family> {
   /// mu); convergence_error (every rank) if it does not converge or does work on the modes at
   /// rest (largest generalised force above max_load), as wing_system::steady_equilibrium.
   vec<double> equilibrium(const system_type& s, double /*mu*/) const {
-    wing_on_ranks r(s, comm_, cut_axis_);
-    flow::euler_model<3> m = r.system().flow();
-    distributed_euler<3> d(m, partition_blocks(m, ranks_), comm_);
-    distributed_euler_discretisation<3> disc(m, d);
-    vec<double> wf = d.local_part(m.free_stream_vector());
-    const auto rep = flow::solve_steady(disc, wf, serial_.steady_options());
-    const double mach = s.flow().conditions().mach;
-    if (!rep.converged)
-      throw convergence_error(aerohopf::internal::concat(
-          "distributed::wing_family: the steady flow at M = ", mach, " on ", ranks_, " ranks did not converge (",
-          rep.steps, " steps, residual ", rep.final_residual, ": ", rep.reason, ")"));
+    const flow::split_grid<3> cut = split_for_ranks(s.flow().grid(), ranks_, 1.1, cut_axis_);
+    const flow::euler_model<3> m(cut.grid, s.flow().conditions(), s.flow().options());
     vec<double> w = s.free_stream_state();
-    w.head(s.flow_size()) = d.all_gather(wf);
-    w = flow::from_split_order(r.cut(), w, wing_on_ranks::nv);
+    w.head(s.flow_size()) = steady_flow_on_ranks(m, comm_, serial_.steady_options(), "distributed::wing_family");
+    w = flow::from_split_order(cut, w, wing_on_ranks::nv);
+    const double mach = s.flow().conditions().mach;
     const double g = s.generalised_forces<double>(w).cwiseAbs().maxCoeff();
     if (!(g <= max_load))
       throw convergence_error(aerohopf::internal::concat(

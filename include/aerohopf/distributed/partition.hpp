@@ -81,8 +81,9 @@ block_partition partition_blocks(const flow::euler_model<Dim>& m, int ranks) {
 
 /// A grid whose blocks whole-block partitioning can spread over `ranks` ranks within
 /// `max_imbalance` (largest rank's cells over the mean): the largest block is cut along its
-/// longest axis (or along `axis` while it has 4 cells or more; flow::split_block), one rank's share (total cells / ranks) off it where it holds
-/// more than that, else in half, until partition_blocks reaches the bound, or the largest block
+/// longest axis (or along `axis` while that has 4 cells or more; flow::split_block), one rank's
+/// share (total cells / ranks) off it where it holds more than that, else in half, until
+/// partition_blocks reaches the bound, or the largest block
 /// has fewer than 4 cells along every axis (then the grid so far is returned; check
 /// partition_blocks(...).imbalance()). A single-block wing grid becomes `ranks` blocks of equal
 /// size where its longest axis divides so (the AGARD medium grid for 3 ranks: 3 blocks; halving
