@@ -152,7 +152,7 @@ using test_support::faulty_system;
 using test_support::moving_equilibrium_system;
 using cplx = std::complex<double>;
 
-const Eigen::Vector4d moving_c(1.0, 0.5, -0.3, 0.2);
+using test_support::moving_c;
 
 /// A guess near the real eigenvalue at mu = 0 from which Newton on the fixed-equilibrium system
 /// converges (at abs_tolerance 1e-8) to omega ~ 1e-11: the inverse-power eigenvector at

@@ -244,7 +244,7 @@ using test_support::faulty_system;
 using test_support::moving_equilibrium_system;
 using dense_sys = moving_equilibrium_system<Eigen::MatrixXd>;
 using sparse_sys = moving_equilibrium_system<Eigen::SparseMatrix<double>>;
-const Eigen::Vector4d moving_c(1.0, 0.5, -0.3, 0.2);
+using test_support::moving_c;
 
 hopf_options fixed_options(double tol = 1e-10) {
   hopf_options o;

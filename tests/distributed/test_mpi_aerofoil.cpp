@@ -220,4 +220,4 @@ TEST(mpi_aerofoil, bad_input_is_refused_on_every_rank) {
   EXPECT_EQ(d.residual(local, 4.0).size(), local.size());  // and the ranks carry on
 }
 
-int main(int argc, char** argv) { return aerohopf::test::run_tests_on_ranks(argc, argv); }
+AEROHOPF_MPI_TEST_MAIN();

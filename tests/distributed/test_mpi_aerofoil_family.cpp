@@ -29,6 +29,7 @@
 #include <vector>
 
 #include "support/error_messages.hpp"
+#include "support/mpi_boundary.hpp"
 #include "support/mpi_test.hpp"
 
 using namespace aerohopf;
@@ -36,60 +37,22 @@ using aerohopf::test::world_size;
 
 namespace {
 
-models::aerofoil_family serial_family(double alpha_rad = 0.0) {
+models::aerofoil_family serial_aerofoil_family(double alpha_rad = 0.0) {
   structure::pitch_plunge_parameters p;
   p.mu_s = 10;
   return models::aerofoil_family(flow::naca_cgrid(), p, {}, alpha_rad);
 }
 
-int rank() { return test::world_rank(); }
+using test::expect_serial_boundary;
 using test::same_on_every_rank;
+using test::world_rank;
 
 constexpr int very_coarse = 8;
-
-/// The boundary of `dist` and of `serial` on the very coarse grid at machs with options o
-/// (Newton to ||F|| <= 1e-10: the driver's default 1e-7 leaves Ubar* a few 1e-8 from the limit,
-/// differently on the ranks, whose GMRES iterates differ): the same Mach numbers, Ubar* and
-/// omega* to 1e-8 relative, the same on every rank; moving: also the static pitch deflection.
-void expect_serial_boundary(const models::aerofoil_family& serial, const distributed::aerofoil_family& dist,
-                            const std::vector<double>& machs, flutter_boundary_options o, const std::string& label,
-                            bool moving) {
-  o.tolerance = 1e-10;
-  o.log = nullptr;
-  o.label = label;
-  const flutter_boundary ref = trace_flutter_boundary(serial, very_coarse, machs, nullptr, o);
-  o.log = rank() == 0 ? &std::cout : nullptr;
-  o.label = label + " on " + std::to_string(world_size()) + " ranks";
-  const flutter_boundary b = trace_flutter_boundary(dist, very_coarse, machs, nullptr, o);
-  ASSERT_TRUE(ref.complete) << ref.stop_reason;
-  ASSERT_TRUE(b.complete) << b.stop_reason;
-  ASSERT_EQ(b.points.size(), ref.points.size());
-  for (std::size_t k = 0; k < b.points.size(); ++k) {
-    const auto &p = b.points[k], &q = ref.points[k];
-    EXPECT_EQ(p.mach, q.mach);
-    EXPECT_LT(std::abs(p.mu - q.mu), 1e-8 * q.mu) << "M = " << p.mach << ": Ubar* " << p.mu << " vs " << q.mu;
-    EXPECT_LT(std::abs(p.omega - q.omega), 1e-8 * q.omega) << "M = " << p.mach;
-    EXPECT_TRUE(same_on_every_rank(p.mu)) << "M = " << p.mach;
-    EXPECT_GT(p.linear_iterations, 0);
-    const double pitch = p.point.w[p.point.w.size() - 2], pitch_ref = q.point.w[q.point.w.size() - 2];
-    if (moving) {
-      EXPECT_GT(pitch, 1e-4);  // the static deflection at the flutter point
-      EXPECT_LT(std::abs(pitch - pitch_ref), 1e-8 * pitch_ref) << "M = " << p.mach;
-    }
-    if (rank() == 0)
-      std::cout << label << ", M = " << p.mach << ": Ubar* " << std::setprecision(12) << p.mu << " (serial " << q.mu
-                << "), omega* " << p.omega << " (serial " << q.omega << "), static pitch " << pitch << " (serial "
-                << pitch_ref << "), " << p.newton_iterations << " Newton / " << p.linear_iterations << " GMRES (serial "
-                << q.newton_iterations << " / " << q.linear_iterations << ")\n";
-  }
-  EXPECT_EQ(b.checks.size(), ref.checks.size());
-  EXPECT_TRUE(b.checks_passed());
-}
 
 }  // namespace
 
 TEST(mpi_aerofoil_family, equilibrium_and_start_equal_the_serial_ones) {
-  const auto serial = serial_family();
+  const auto serial = serial_aerofoil_family();
   const distributed::aerofoil_family dist(serial, MPI_COMM_WORLD);
   const models::aerofoil_system s = serial.system(very_coarse, 0.6);
   const vec<double> ws = serial.equilibrium(s, 1.66);
@@ -117,19 +80,19 @@ TEST(mpi_aerofoil_family, equilibrium_and_start_equal_the_serial_ones) {
 }
 
 TEST(mpi_aerofoil_family, flutter_boundary_equals_the_serial_one) {
-  const auto serial = serial_family();
+  const auto serial = serial_aerofoil_family();
   const distributed::aerofoil_family dist(serial, MPI_COMM_WORLD);
   const std::vector<double> machs{0.5, 0.55, 0.6, 0.65};
   flutter_boundary_options o = serial.boundary_options();
   o.start_mu = 1.66;
   o.start_omega = 0.75;
-  expect_serial_boundary(serial, dist, machs, o, "light very coarse", false);
+  expect_serial_boundary(serial, dist, very_coarse, machs, o, "light very coarse");
 }
 
 // A mean incidence of 1 deg: every point a full Hopf system about the static aeroelastic
 // equilibrium (solved on the ranks), the static pitch deflection moving with Ubar.
 TEST(mpi_aerofoil_family, moving_equilibrium_boundary_equals_the_serial_one) {
-  const auto serial = serial_family(std::numbers::pi / 180);
+  const auto serial = serial_aerofoil_family(std::numbers::pi / 180);
   const distributed::aerofoil_family dist(serial, MPI_COMM_WORLD);
   EXPECT_FALSE(dist.fixed_equilibrium());
   const std::vector<double> machs{0.5, 0.55};
@@ -137,7 +100,14 @@ TEST(mpi_aerofoil_family, moving_equilibrium_boundary_equals_the_serial_one) {
   o.start_mu = 1.66;
   o.start_omega = 0.75;
   o.check_crossings = false;  // a V-g scan at each checked point: serial work replicated on the ranks
-  expect_serial_boundary(serial, dist, machs, o, "light very coarse alpha 1", true);
+  expect_serial_boundary(serial, dist, very_coarse, machs, o, "light very coarse alpha 1",
+                         [](const flutter_boundary_point& p, const flutter_boundary_point& q) {
+                           // the static pitch deflection at the flutter point
+                           const double pitch = p.point.w[p.point.w.size() - 2];
+                           const double pitch_ref = q.point.w[q.point.w.size() - 2];
+                           EXPECT_GT(pitch, 1e-4) << "M = " << p.mach;
+                           EXPECT_LT(std::abs(pitch - pitch_ref), 1e-8 * pitch_ref) << "M = " << p.mach;
+                         });
 }
 
-int main(int argc, char** argv) { return aerohopf::test::run_tests_on_ranks(argc, argv); }
+AEROHOPF_MPI_TEST_MAIN();

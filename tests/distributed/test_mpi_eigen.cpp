@@ -106,4 +106,4 @@ TEST(mpi_eigen, bad_input_is_refused_on_every_rank) {
   EXPECT_THROW(distributed::inverse_power(d, bad, nullptr, cd(0, 0.1)), input_error);
 }
 
-int main(int argc, char** argv) { return aerohopf::test::run_tests_on_ranks(argc, argv); }
+AEROHOPF_MPI_TEST_MAIN();

@@ -186,4 +186,4 @@ TEST(mpi_euler, errors_are_collective) {
   EXPECT_THROW(distributed_euler<2>(m, wrong, MPI_COMM_WORLD), input_error);
 }
 
-int main(int argc, char** argv) { return aerohopf::test::run_tests_on_ranks(argc, argv); }
+AEROHOPF_MPI_TEST_MAIN();

@@ -247,4 +247,4 @@ TEST(mpi_hopf, bad_input_and_failures_are_the_same_on_every_rank) {
   EXPECT_TRUE(test::contains(msg, "not contracting at iterate 1")) << msg;
 }
 
-int main(int argc, char** argv) { return aerohopf::test::run_tests_on_ranks(argc, argv); }
+AEROHOPF_MPI_TEST_MAIN();

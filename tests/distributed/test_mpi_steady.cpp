@@ -134,4 +134,4 @@ TEST(mpi_steady, failures_are_the_same_on_every_rank) {
   EXPECT_TRUE(flow::solve_steady(disc, w, flow::steady_options{}).converged);
 }
 
-int main(int argc, char** argv) { return aerohopf::test::run_tests_on_ranks(argc, argv); }
+AEROHOPF_MPI_TEST_MAIN();

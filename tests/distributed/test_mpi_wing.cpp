@@ -240,4 +240,4 @@ TEST(mpi_wing, bad_input_is_refused_on_every_rank) {
   EXPECT_EQ(d.residual(local, 0.075).size(), local.size());  // and the ranks carry on
 }
 
-int main(int argc, char** argv) { return aerohopf::test::run_tests_on_ranks(argc, argv); }
+AEROHOPF_MPI_TEST_MAIN();

@@ -25,6 +25,7 @@
 #include <string>
 #include <vector>
 
+#include "support/mpi_boundary.hpp"
 #include "support/mpi_test.hpp"
 #include "support/wing_cases.hpp"
 
@@ -34,7 +35,7 @@ using aerohopf::test::world_size;
 namespace {
 
 /// The tiny wing's family, the test schedule's speed of sound (spec 06).
-models::wing_family serial_family() {
+models::wing_family serial_wing_family() {
   models::speed_of_sound_schedule s;
   s.mach = {0.499, 0.678, 0.901, 0.960};
   s.speed_of_sound = {172.46 / 0.499, 231.37 / 0.678, 296.69 / 0.901, 310.96 / 0.960};
@@ -42,13 +43,14 @@ models::wing_family serial_family() {
                              test_support::agard_plate_modes(), Eigen::VectorXd::Zero(1), s);
 }
 
-int rank() { return test::world_rank(); }
+using test::expect_serial_boundary;
 using test::same_on_every_rank;
+using test::world_rank;
 
 }  // namespace
 
 TEST(mpi_wing_family, equilibrium_and_start_equal_the_serial_ones) {
-  const auto serial = serial_family();
+  const auto serial = serial_wing_family();
   const distributed::wing_family dist(serial, MPI_COMM_WORLD);
   const models::wing_system s = serial.system(1, 0.5);
   {  // whole vectors to the ranks and back
@@ -63,7 +65,7 @@ TEST(mpi_wing_family, equilibrium_and_start_equal_the_serial_ones) {
   EXPECT_LT((wd - ws).norm(), 1e-8 * ws.norm());  // the same stopping test; only the preconditioner differs
   const double fd = s.residual<double>(wd, 0.075).norm(), fs = s.residual<double>(ws, 0.075).norm();
   EXPECT_LT(fd, 10 * fs + 1e-12);  // the same stopping test (a drop relative to the first residual) as the serial
-  if (rank() == 0) std::cout << "||f|| of the equilibrium on the ranks " << fd << ", serial " << fs << "\n";
+  if (world_rank() == 0) std::cout << "||f|| of the equilibrium on the ranks " << fd << ", serial " << fs << "\n";
   EXPECT_TRUE(same_on_every_rank(wd.sum()));
 
   hopf_start_krylov_options so;
@@ -80,33 +82,13 @@ TEST(mpi_wing_family, equilibrium_and_start_equal_the_serial_ones) {
 }
 
 TEST(mpi_wing_family, flutter_boundary_equals_the_serial_one) {
-  const auto serial = serial_family();
+  const auto serial = serial_wing_family();
   const distributed::wing_family dist(serial, MPI_COMM_WORLD);
   const std::vector<double> machs{0.5, 0.55, 0.6};
   flutter_boundary_options o = serial.boundary_options();
   o.start_mu = 0.075;
   o.start_omega = 0.4;
-  o.tolerance = 1e-10;
-  o.log = nullptr;
-  const flutter_boundary ref = trace_flutter_boundary(serial, 1, machs, nullptr, o);
-  o.log = rank() == 0 ? &std::cout : nullptr;
-  o.label = "tiny wing on " + std::to_string(world_size()) + " ranks";
-  const flutter_boundary b = trace_flutter_boundary(dist, 1, machs, nullptr, o);
-  ASSERT_TRUE(ref.complete) << ref.stop_reason;
-  ASSERT_TRUE(b.complete) << b.stop_reason;
-  ASSERT_EQ(b.points.size(), ref.points.size());
-  for (std::size_t k = 0; k < b.points.size(); ++k) {
-    const auto &p = b.points[k], &q = ref.points[k];
-    EXPECT_EQ(p.mach, q.mach);
-    EXPECT_LT(std::abs(p.mu - q.mu), 1e-8 * q.mu) << "M = " << p.mach << ": mu* " << p.mu << " vs " << q.mu;
-    EXPECT_LT(std::abs(p.omega - q.omega), 1e-8 * q.omega) << "M = " << p.mach;
-    EXPECT_TRUE(same_on_every_rank(p.mu)) << "M = " << p.mach;
-    if (rank() == 0)
-      std::cout << "M = " << p.mach << ": mu* " << std::setprecision(12) << p.mu << " (serial " << q.mu << "), omega* "
-                << p.omega << " (serial " << q.omega << "), " << p.newton_iterations << " Newton / "
-                << p.linear_iterations << " GMRES (serial " << q.newton_iterations << " / " << q.linear_iterations
-                << ")\n";
-  }
+  expect_serial_boundary(serial, dist, 1, machs, o, "tiny wing");
 }
 
-int main(int argc, char** argv) { return aerohopf::test::run_tests_on_ranks(argc, argv); }
+AEROHOPF_MPI_TEST_MAIN();

@@ -18,6 +18,7 @@
 #include <aerohopf/structure/wing_plate.hpp>
 
 #include "support/dense_spectrum.hpp"
+#include "support/tiny_wing_system.hpp"
 #include "support/wing_cases.hpp"
 
 #include <cmath>
@@ -31,34 +32,18 @@ using models::wing_system;
 
 namespace {
 using test_support::agard;
-flow::wing_grid_options tiny_options() { return test_support::tiny_wing_options(); }
-const flow::multiblock_grid<3>& tiny_grid() {
-  static const flow::multiblock_grid<3> g = flow::wing_cgrid(agard(), tiny_options());
-  return g;
-}
-const structure::modal_data& plate_modes() { return test_support::agard_plate_modes(); }
-coupling::wing_modal_motion motion_of(const structure::modal_data& d) {
-  coupling::wing_motion_options o;
-  o.length_scale = agard().planform.root_chord;
-  o.grid = tiny_options();
-  return coupling::wing_modal_motion(tiny_grid(), d, o);
-}
-/// M = 0.5 at U = 170 m/s, damping ratio zeta in every mode.
-wing_system tiny_wing(double alpha_deg = 0.0, double zeta = 0.0, const structure::modal_data& d = plate_modes()) {
-  const double c = agard().planform.root_chord;
-  return wing_system(flow::euler_model<3>(tiny_grid(), {.mach = 0.5, .alpha_rad = alpha_deg * std::numbers::pi / 180},
-                                          {.force_tag = "wing"}),
-                     motion_of(d),
-                     structure::modal_structure::from_physical(d.omega, Eigen::VectorXd::Constant(d.modes(), zeta), c,
-                                                               170.0));
-}
+using test_support::agard_plate_modes;
+using test_support::tiny_wing;
+using test_support::tiny_wing_grid;
+using test_support::tiny_wing_motion;
+using test_support::tiny_wing_options;
 const vec<double>& rest_equilibrium() {
   static const vec<double> w = tiny_wing().steady_equilibrium();
   return w;
 }
 /// Two synthetic modes at the plate nodes: heave t3 = 1 and pitch t3 = -(x - x0) (nose up).
 structure::modal_data heave_and_pitch(double x0) {
-  const structure::modal_data& p = plate_modes();
+  const structure::modal_data& p = agard_plate_modes();
   structure::modal_data d;
   d.point_ids = p.point_ids;
   d.points = p.points;
@@ -112,7 +97,7 @@ TEST(wing_system, jacobians_are_the_derivatives_of_the_residual_at_rest_and_on_a
 // on a moved grid.
 TEST(wing_system, on_a_cut_grid_is_the_whole_grid_system_reordered) {
   const wing_system s = tiny_wing(0.0, 0.02);
-  const auto cut = distributed::split_for_ranks(tiny_grid(), 3);
+  const auto cut = distributed::split_for_ranks(tiny_wing_grid(), 3);
   ASSERT_GE(cut.grid.points.blocks.size(), 3u);
   const wing_system c = models::split_wing_system(s, cut);
   ASSERT_EQ(c.size(), s.size());
@@ -184,7 +169,7 @@ TEST(wing_system, uniform_flow_on_the_moving_grid_loads_no_mode) {
   const vec<double> r = s.residual(w, 0.1);
   // GCL: the moving grid keeps the uniform flow in every cell whose stencil does not reach the
   // wall's halo (j >= 2; the slip wall turns the flow, the far field keeps it)
-  const auto cells = tiny_grid().points.blocks[0].cells();
+  const auto cells = tiny_wing_grid().points.blocks[0].cells();
   double off_wall = 0, at_wall = 0;
   for (Eigen::Index c = 0; c < nf / wing_system::nv; ++c) {
     const double rc = r.segment(c * wing_system::nv, wing_system::nv).cwiseAbs().maxCoeff();
@@ -203,20 +188,20 @@ TEST(wing_system, uniform_flow_on_the_moving_grid_loads_no_mode) {
 
 TEST(wing_system, refuses_bad_input) {
   const double c = agard().planform.root_chord;
-  const auto st = structure::modal_structure::from_physical(plate_modes().omega, Eigen::VectorXd::Zero(4), c, 170);
+  const auto st = structure::modal_structure::from_physical(agard_plate_modes().omega, Eigen::VectorXd::Zero(4), c, 170);
   // no force tag: the symmetry plane would be loaded too
-  EXPECT_THROW(wing_system(flow::euler_model<3>(tiny_grid(), {.mach = 0.5}), motion_of(plate_modes()), st),
+  EXPECT_THROW(wing_system(flow::euler_model<3>(tiny_wing_grid(), {.mach = 0.5}), tiny_wing_motion(agard_plate_modes()), st),
                input_error);
   // a tag that names no wall
-  EXPECT_THROW(wing_system(flow::euler_model<3>(tiny_grid(), {.mach = 0.5}, {.force_tag = "flap"}),
-                           motion_of(plate_modes()), st),
+  EXPECT_THROW(wing_system(flow::euler_model<3>(tiny_wing_grid(), {.mach = 0.5}, {.force_tag = "flap"}),
+                           tiny_wing_motion(agard_plate_modes()), st),
                input_error);
   // three structural modes for a motion of four
   Eigen::VectorXd k3(3);
   k3 << 0.2, 0.8, 1.0;
   const auto three = structure::modal_structure(k3, Eigen::VectorXd::Zero(3));
-  EXPECT_THROW(wing_system(flow::euler_model<3>(tiny_grid(), {.mach = 0.5}, {.force_tag = "wing"}),
-                           motion_of(plate_modes()), three),
+  EXPECT_THROW(wing_system(flow::euler_model<3>(tiny_wing_grid(), {.mach = 0.5}, {.force_tag = "wing"}),
+                           tiny_wing_motion(agard_plate_modes()), three),
                input_error);
   const wing_system s = tiny_wing();
   vec<double> w = rest_equilibrium();

@@ -21,8 +21,8 @@ using models::wing_family;
 
 namespace {
 using test_support::agard;
-flow::wing_grid_options tiny_options() { return test_support::tiny_wing_options(); }
-const structure::modal_data& plate_modes() { return test_support::agard_plate_modes(); }
+using test_support::agard_plate_modes;
+using test_support::tiny_wing_options;
 /// Spec 06: M, density, speed, mass ratio, FSI, omega_f / omega_alpha.
 constexpr double table[4][6] = {{0.499, 0.4278, 172.46, 33.465, 0.4459, 0.5353},
                                 {0.678, 0.2082, 231.37, 68.753, 0.4174, 0.4722},
@@ -83,14 +83,14 @@ TEST(wing_family, flutter_numbers_reproduce_the_experiment_table) {
 }
 
 TEST(wing_family, levels_systems_and_transfers) {
-  const wing_family f(agard(), tiny_options(), {2, 1}, plate_modes(), Eigen::VectorXd::Constant(1, 0.005), tunnel());
+  const wing_family f(agard(), tiny_wing_options(), {2, 1}, agard_plate_modes(), Eigen::VectorXd::Constant(1, 0.005), tunnel());
   const models::wing_system fine = f.system(1, 0.9), coarse = f.system(2, 0.9);
   EXPECT_EQ(fine.flow_size(), 5 * 16 * 4 * 6);
   EXPECT_EQ(coarse.flow_size(), 5 * 8 * 2 * 3);
   EXPECT_EQ(fine.structure_size(), 8);
   const double u = f.sound().speed(0.9), c = agard().planform.root_chord;
   for (Eigen::Index i = 0; i < 4; ++i) {
-    EXPECT_NEAR(fine.structure().reduced_frequency()[i], plate_modes().omega[i] * c / u, 1e-12);
+    EXPECT_NEAR(fine.structure().reduced_frequency()[i], agard_plate_modes().omega[i] * c / u, 1e-12);
     EXPECT_EQ(fine.structure().damping_ratio()[i], 0.005);
   }
   EXPECT_TRUE(f.refines(2, 1));
@@ -108,15 +108,15 @@ TEST(wing_family, levels_systems_and_transfers) {
   // refusals
   EXPECT_THROW(f.system(4, 0.9), input_error);  // no such level
   EXPECT_THROW(f.system(1, -0.9), input_error);
-  EXPECT_THROW(wing_family(agard(), tiny_options(), {3}, plate_modes(), Eigen::VectorXd::Zero(1), tunnel()),
+  EXPECT_THROW(wing_family(agard(), tiny_wing_options(), {3}, agard_plate_modes(), Eigen::VectorXd::Zero(1), tunnel()),
                input_error);
-  EXPECT_THROW(wing_family(agard(), tiny_options(), {1}, plate_modes(), Eigen::VectorXd::Zero(3), tunnel()),
+  EXPECT_THROW(wing_family(agard(), tiny_wing_options(), {1}, agard_plate_modes(), Eigen::VectorXd::Zero(3), tunnel()),
                input_error);
-  EXPECT_THROW(wing_family(agard(), tiny_options(), {1}, plate_modes(), Eigen::VectorXd::Zero(1), {}), input_error);
+  EXPECT_THROW(wing_family(agard(), tiny_wing_options(), {1}, agard_plate_modes(), Eigen::VectorXd::Zero(1), {}), input_error);
 }
 
 TEST(wing_family, flutter_boundary_driver_runs_on_the_wing) {
-  const wing_family f(agard(), tiny_options(), {1}, plate_modes(), Eigen::VectorXd::Zero(1), tunnel());
+  const wing_family f(agard(), tiny_wing_options(), {1}, agard_plate_modes(), Eigen::VectorXd::Zero(1), tunnel());
   flutter_boundary_options o = f.boundary_options();
   o.start_mu = 0.075;
   o.start_omega = 0.4;
@@ -153,7 +153,7 @@ TEST(wing_family, log_secant_predicts_a_falling_boundary_without_crossing_zero) 
   // (positive_parameter, the family's default) every listed Mach number is reached from the
   // previous point in one attempt; the linear secant's prediction at the last one is below the
   // log one's (here: the tiny grid's points, 0.5 -> 0.9)
-  const wing_family f(agard(), tiny_options(), {1}, plate_modes(), Eigen::VectorXd::Zero(1), tunnel());
+  const wing_family f(agard(), tiny_wing_options(), {1}, agard_plate_modes(), Eigen::VectorXd::Zero(1), tunnel());
   flutter_boundary_options o = f.boundary_options();
   ASSERT_TRUE(o.positive_parameter);
   ASSERT_EQ(o.mu_min, 1e-4);

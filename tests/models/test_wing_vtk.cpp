@@ -15,22 +15,13 @@
 #include <sstream>
 #include <string>
 
-#include "support/wing_cases.hpp"
+#include "support/tiny_wing_system.hpp"
 
 using namespace aerohopf;
 using models::wing_system;
 
 namespace {
-wing_system tiny_wing() {
-  const auto& d = test_support::agard_plate_modes();
-  static const flow::multiblock_grid<3> g = flow::wing_cgrid(test_support::agard(), test_support::tiny_wing_options());
-  coupling::wing_motion_options o;
-  o.length_scale = test_support::agard().planform.root_chord;
-  o.grid = test_support::tiny_wing_options();
-  return wing_system(flow::euler_model<3>(g, {.mach = 0.5}, {.force_tag = "wing"}), coupling::wing_modal_motion(g, d, o),
-                     structure::modal_structure::from_physical(d.omega, Eigen::VectorXd::Zero(4),
-                                                               o.length_scale, 170.0));
-}
+using test_support::tiny_wing;
 /// A "Hopf point" with a complex eigenvector mixing the modes with different phases.
 hopf_point synthetic_point(const wing_system& s) {
   hopf_point h;

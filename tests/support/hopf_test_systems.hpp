@@ -24,6 +24,9 @@
 
 namespace aerohopf::test_support {
 
+/// The equilibrium slope c (w*(mu) = c mu) the Hopf tests give moving_equilibrium_system.
+inline const Eigen::Vector4d moving_c{1.0, 0.5, -0.3, 0.2};
+
 template <class Jacobian = Eigen::MatrixXd>
 class moving_equilibrium_system {
  public:

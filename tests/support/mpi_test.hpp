@@ -47,3 +47,13 @@ inline int run_tests_on_ranks(int argc, char** argv) {
 }
 
 }  // namespace aerohopf::test
+
+// The main of an MPI test file: its own, or none in a bundle of several files
+// (AEROHOPF_TEST_BUNDLE; support/mpi_bundle_main.cpp defines the bundle's).
+#ifdef AEROHOPF_TEST_BUNDLE
+#define AEROHOPF_MPI_TEST_MAIN() static_assert(true)
+#else
+#define AEROHOPF_MPI_TEST_MAIN() \
+  int main(int argc, char** argv) { return aerohopf::test::run_tests_on_ranks(argc, argv); } \
+  static_assert(true)
+#endif
