@@ -218,7 +218,7 @@ struct flutter_boundary_options {
   bool check_crossings = true;
   double crossing_omega_min = 0.05, crossing_omega_factor = 6.0, crossing_min_fraction = 0.2;
   double crossing_mu_tolerance = 1e-5, crossing_omega_tolerance = 1e-4;
-  bool verbose = false;           ///< a line per Newton iteration
+  bool verbose = false;           ///< a line per Newton iteration (and per V-g scan step and failed inverse power)
   std::ostream* log = &std::cout;  ///< a line per point and attempt (nullptr: silent)
   std::string label = "boundary";
 };
@@ -415,6 +415,17 @@ struct moving_scan_result {
 /// Ubar = 1, -0.052 rad from rest in one step), so the scan follows the branch reached by a
 /// rising speed. Ends where the tracking or the equilibrium is lost and, with
 /// stop_after_flutter, one parameter after the first rising zero of g.
+/// A family whose `scan_eigen(s, vg_krylov_options)` returns the V-g scan's inverse power,
+/// eig(w, mu, shift, start, inverse_power_options) -> eigen_pair (the vector whole; failures as
+/// convergence_error or singular_matrix_error), in place of vg_krylov_solvers on s (above
+/// flutter_boundary_options::scan_direct_max_unknowns; below, the sparse LU as for any family).
+template <class F>
+concept has_scan_eigen = requires(const F& f, const typename F::system_type& s, const vg_krylov_options& ko,
+                                  const vec<double>& w, double mu, std::complex<double> shift,
+                                  const vec<std::complex<double>>* start, const inverse_power_options& po) {
+  { f.scan_eigen(s, ko)(w, mu, shift, start, po) } -> std::convertible_to<eigen_pair>;
+};
+
 template <flutter_family F>
 moving_scan_result moving_vg_scan(const F& f, const typename F::system_type& s, const std::vector<double>& mus,
                                   const flutter_boundary_options& o, bool stop_after_flutter,
@@ -468,12 +479,21 @@ moving_scan_result moving_vg_scan(const F& f, const typename F::system_type& s, 
     vo.partial_on_lost_tracking = true;
     vo.stop_after_flutter = stop_after_flutter;
     vo.log = o.log;
+    vo.verbose = o.verbose;
+    vg_krylov_options ko;
+    ko.fill_level = o.fill_level;
+    ko.krylov.relative_tolerance = 0.1 * o.scan_tolerance;
     if (s.size() <= o.scan_direct_max_unknowns) {
       r.vg = vg_diagram(s, equilibrium, mus, starts, vo);
+    } else if constexpr (has_scan_eigen<F>) {
+      // the family's own inverse powers (e.g. on MPI ranks): eig(w, mu, shift, start, options)
+      auto eig = f.scan_eigen(s, ko);
+      r.vg = vg_trace(s, equilibrium, mus, starts, vo,
+                      [&](const jacobian_t<S>&, const vec<double>& w, double mu, std::complex<double> shift,
+                          const vec<std::complex<double>>* start) {
+                        return eig(w, mu, shift, start, vo.inverse_power);
+                      });
     } else {
-      vg_krylov_options ko;
-      ko.fill_level = o.fill_level;
-      ko.krylov.relative_tolerance = 0.1 * o.scan_tolerance;
       r.vg = vg_diagram(s, equilibrium, mus, starts, vo, vg_krylov_solvers<B>(s, ko));
     }
     for (const auto& x : r.vg.flutter)
