@@ -102,7 +102,7 @@ TEST(mpi_aerofoil_family, moving_equilibrium_boundary_equals_the_serial_one) {
   o.start_omega = 0.75;
   // the last point's crossing check: a V-g scan from below Ubar*, its inverse powers on the ranks
   // (serially BILU-GMRES too: the LU a grid this small gets by default is off)
-  static_assert(internal::has_scan_eigen<distributed::aerofoil_family>);
+  static_assert(aerohopf::internal::has_scan_eigen<distributed::aerofoil_family>);
   o.scan_direct_max_unknowns = 0;
   expect_serial_boundary(serial, dist, very_coarse, machs, o, "light very coarse alpha 1",
                          [](const flutter_boundary_point& p, const flutter_boundary_point& q) {

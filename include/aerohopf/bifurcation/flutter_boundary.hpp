@@ -49,6 +49,7 @@
 #include <complex>
 #include <concepts>
 #include <cstdarg>
+#include <cstddef>
 #include <cstdio>
 #include <deque>
 #include <iostream>
@@ -486,13 +487,13 @@ moving_scan_result moving_vg_scan(const F& f, const typename F::system_type& s, 
     if (s.size() <= o.scan_direct_max_unknowns) {
       r.vg = vg_diagram(s, equilibrium, mus, starts, vo);
     } else if constexpr (has_scan_eigen<F>) {
-      // the family's own inverse powers (e.g. on MPI ranks): eig(w, mu, shift, start, options)
+      // the family's own inverse powers (e.g. on MPI ranks): eig(w, mu, shift, start, options);
+      // it assembles what it needs itself, so nothing is made per parameter here
       auto eig = f.scan_eigen(s, ko);
-      r.vg = vg_trace(s, equilibrium, mus, starts, vo,
-                      [&](const jacobian_t<S>&, const vec<double>& w, double mu, std::complex<double> shift,
-                          const vec<std::complex<double>>* start) {
-                        return eig(w, mu, shift, start, vo.inverse_power);
-                      });
+      r.vg = vg_trace(
+          s, equilibrium, mus, starts, vo, [](const vec<double>&, double) { return nullptr; },
+          [&](std::nullptr_t, const vec<double>& w, double mu, std::complex<double> shift,
+              const vec<std::complex<double>>* start) { return eig(w, mu, shift, start, vo.inverse_power); });
     } else {
       r.vg = vg_diagram(s, equilibrium, mus, starts, vo, vg_krylov_solvers<B>(s, ko));
     }

@@ -237,10 +237,17 @@ struct vg_mode_state {
   }
 };
 
-/// The tracer; eig(a, w, mu, shift, start) returns an eigen_pair or throws.
-template <dynamical_system S, class Equilibrium, class Eig>
+/// The tracer's at(w, mu) of the inverse powers by a factorisation of J: the Jacobian.
+template <dynamical_system S>
+auto vg_jacobian_at(const S& sys) {
+  return [&sys](const vec<double>& w, double mu) { return sys.jacobian(w, mu); };
+}
+
+/// The tracer; at(w, mu) makes what the inverse powers at one parameter share (the Jacobian,
+/// once per parameter), eig(a, w, mu, shift, start) returns an eigen_pair or throws.
+template <dynamical_system S, class Equilibrium, class At, class Eig>
 vg_result vg_trace(const S& sys, const Equilibrium& equilibrium, const std::vector<double>& mus,
-                   const std::vector<vg_mode_start>& starts, const vg_options& opt, Eig&& eig) {
+                   const std::vector<vg_mode_start>& starts, const vg_options& opt, At&& at, Eig&& eig) {
   using C = std::complex<double>;
   constexpr const char* who = "vg_diagram";
   const Eigen::Index n = sys.size();
@@ -300,7 +307,7 @@ vg_result vg_trace(const S& sys, const Equilibrium& equilibrium, const std::vect
     vec<C> tracked;
   };
   // one inverse power; a failed one (no convergence, singular shift) is no candidate
-  auto solve = [&](const jacobian_t<S>& a, const vec<double>& w, double mu, C shift, const vec<C>* start,
+  auto solve = [&](const auto& a, const vec<double>& w, double mu, C shift, const vec<C>* start,
                    std::vector<candidate>& cand) {
     try {
       eigen_pair ep = eig(a, w, mu, shift, start);
@@ -365,7 +372,7 @@ vg_result vg_trace(const S& sys, const Equilibrium& equilibrium, const std::vect
   {
     const double mu = mus.front();
     const vec<double> w = equilibrium_at(mu);
-    const jacobian_t<S> a = sys.jacobian(w, mu);
+    const auto a = at(w, mu);
     std::vector<candidate> cand;
     for (int k = 0; k < m; ++k) {
       vec<C> start;
@@ -405,7 +412,7 @@ vg_result vg_trace(const S& sys, const Equilibrium& equilibrium, const std::vect
   std::vector<double> last_residual(m, 0.0);
   auto step_to = [&](double mu) -> bool {
     const vec<double> w = equilibrium_at(mu);
-    const jacobian_t<S> a = sys.jacobian(w, mu);
+    const auto a = at(w, mu);
     std::vector<candidate> cand;
     for (int k = 0; k < m; ++k) solve(a, w, mu, state[k].predicted(mu), &state[k].vector, cand);
     std::vector<vec<C>> refs(m);
@@ -503,7 +510,7 @@ template <dynamical_system S, class Equilibrium>
   requires std::invocable<const Equilibrium&, double>
 vg_result vg_diagram(const S& sys, const Equilibrium& equilibrium, const std::vector<double>& mus,
                      const std::vector<vg_mode_start>& starts, const vg_options& opt = {}) {
-  return internal::vg_trace(sys, equilibrium, mus, starts, opt,
+  return internal::vg_trace(sys, equilibrium, mus, starts, opt, internal::vg_jacobian_at(sys),
                             [&](const jacobian_t<S>& a, const vec<double>&, double, std::complex<double> shift,
                                 const vec<std::complex<double>>* start) {
                               return inverse_power(a, shift, opt.inverse_power, start);
@@ -523,7 +530,7 @@ template <dynamical_system S, class Equilibrium, class SolverOrFactory>
 vg_result vg_diagram(const S& sys, const Equilibrium& equilibrium, const std::vector<double>& mus,
                      const std::vector<vg_mode_start>& starts, const vg_options& opt, SolverOrFactory&& solver) {
   using C = std::complex<double>;
-  return internal::vg_trace(sys, equilibrium, mus, starts, opt,
+  return internal::vg_trace(sys, equilibrium, mus, starts, opt, internal::vg_jacobian_at(sys),
                             [&](const jacobian_t<S>& a, const vec<double>& w, double mu, C shift, const vec<C>* start) {
                               if constexpr (std::invocable<SolverOrFactory&, const vec<double>&, double, C>) {
                                 auto s = solver(w, mu, shift);

@@ -14,8 +14,7 @@
 //    and start refinement;
 //  * scan_eigen: at an incidence, the inverse powers of the driver's V-g scans (a jump's scan,
 //    the crossing check) by distributed::inverse_power, where the system is above the driver's
-//    scan_direct_max_unknowns (below, each rank factors A - sigma I by sparse LU as serially);
-//    the exact Jacobian the scan assembles at each Ubar stays a serial assembly on every rank.
+//    scan_direct_max_unknowns (below, each rank factors A - sigma I by sparse LU as serially).
 // Vectors cross this interface whole: each rank's part of a result is all-gathered, so the
 // driver's predictions, mode test, tracer hand-over and crossing check run on every rank on the
 // same numbers and every rank takes the same decisions
