@@ -408,14 +408,6 @@ struct moving_scan_result {
   double seconds = 0;
 };
 
-/// V-g scan of s over mus (increasing), from the oscillatory modes of the structural block of
-/// A_ss at mus.front() (file comment of vg_diagram.hpp; flutter_boundary_options::scan_from).
-/// The equilibrium is the family's from scratch at mus.front() (w_first if the caller has it),
-/// continued up along mus: below the static divergence the static equilibrium is unique, past it
-/// not (NACA 0012 coarse, alpha_0 = 1 deg, M = 0.70, Ubar = 2.14: +0.154 rad continued up from
-/// Ubar = 1, -0.052 rad from rest in one step), so the scan follows the branch reached by a
-/// rising speed. Ends where the tracking or the equilibrium is lost and, with
-/// stop_after_flutter, one parameter after the first rising zero of g.
 /// A family whose `scan_eigen(s, vg_krylov_options)` returns the V-g scan's inverse power,
 /// eig(w, mu, shift, start, inverse_power_options) -> eigen_pair (the vector whole; failures as
 /// convergence_error or singular_matrix_error), in place of vg_krylov_solvers on s (above
@@ -427,6 +419,14 @@ concept has_scan_eigen = requires(const F& f, const typename F::system_type& s, 
   { f.scan_eigen(s, ko)(w, mu, shift, start, po) } -> std::convertible_to<eigen_pair>;
 };
 
+/// V-g scan of s over mus (increasing), from the oscillatory modes of the structural block of
+/// A_ss at mus.front() (file comment of vg_diagram.hpp; flutter_boundary_options::scan_from).
+/// The equilibrium is the family's from scratch at mus.front() (w_first if the caller has it),
+/// continued up along mus: below the static divergence the static equilibrium is unique, past it
+/// not (NACA 0012 coarse, alpha_0 = 1 deg, M = 0.70, Ubar = 2.14: +0.154 rad continued up from
+/// Ubar = 1, -0.052 rad from rest in one step), so the scan follows the branch reached by a
+/// rising speed. Ends where the tracking or the equilibrium is lost and, with
+/// stop_after_flutter, one parameter after the first rising zero of g.
 template <flutter_family F>
 moving_scan_result moving_vg_scan(const F& f, const typename F::system_type& s, const std::vector<double>& mus,
                                   const flutter_boundary_options& o, bool stop_after_flutter,

@@ -160,12 +160,8 @@ class aerofoil_family : public distributed_family_base<models::aerofoil_family> 
         d.jacobians(d.local_part(w), ubar, cache->a, cache->p);
         cache->ubar = ubar;
       }
-      distributed_inverse_power_options io;
-      io.power = power;
-      io.fill_level = ko.fill_level;
-      io.linear.relative_tolerance = ko.krylov.relative_tolerance;
-      io.linear.restart = std::max(ko.krylov.restart, scan_min_restart);
-      io.linear.max_iterations = ko.krylov.max_iterations;
+      distributed_inverse_power_options io = internal::inverse_power_options_from(ko, power);
+      io.linear.restart = std::max(io.linear.restart, scan_min_restart);
       vec<std::complex<double>> x0;
       if (start) x0 = d.local_part(*start);
       eigen_pair ep = inverse_power(d, cache->a, &cache->p, shift, io, start ? &x0 : nullptr);

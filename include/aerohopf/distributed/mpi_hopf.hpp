@@ -54,6 +54,7 @@
 
 #include <aerohopf/bifurcation/hopf.hpp>
 #include <aerohopf/bifurcation/hopf_bordered.hpp>
+#include <aerohopf/bifurcation/vg_diagram.hpp>
 #include <aerohopf/distributed/mpi_bordered.hpp>
 #include <aerohopf/linalg/krylov.hpp>
 
@@ -607,6 +608,19 @@ inline distributed_inverse_power_options inverse_power_options_from(const hopf_s
   io.linear.relative_tolerance = so.krylov.relative_tolerance;
   io.linear.restart = so.krylov.restart;
   io.linear.max_iterations = so.krylov.max_iterations;
+  return io;
+}
+
+/// The distributed inverse-power options of a V-g scan's (vg_krylov_options: BILU fill, GMRES
+/// tolerance, restart and limit; the eigen-residual target in `power`).
+inline distributed_inverse_power_options inverse_power_options_from(const vg_krylov_options& ko,
+                                                                    const inverse_power_options& power) {
+  distributed_inverse_power_options io;
+  io.power = power;
+  io.fill_level = ko.fill_level;
+  io.linear.relative_tolerance = ko.krylov.relative_tolerance;
+  io.linear.restart = ko.krylov.restart;
+  io.linear.max_iterations = ko.krylov.max_iterations;
   return io;
 }
 
