@@ -3,8 +3,8 @@
 // distributed::aerofoil_family (distributed/mpi_aerofoil_family.hpp), whose steady flows,
 // inverse-power starts and Hopf points are solved on the ranks (at --incidence the static
 // aeroelastic equilibria and full Hopf systems too); the driver's decisions are the same on every
-// rank, rank 0 prints and writes. 1 to 3 ranks (the C-grid's blocks). Built where the distributed
-// component exists (MPI found).
+// rank, rank 0 prints and writes. Any number of ranks (on more than the C-grid's three blocks
+// they are cut first). Built where the distributed component exists (MPI found).
 //
 // Usage: mpirun -np N aerofoil_flutter_mpi [out_dir] [options]
 //   --case light|heavy|both  --grids coarse,medium  --mach-min M --mach-max M --mach-step d

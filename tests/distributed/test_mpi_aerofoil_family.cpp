@@ -1,6 +1,9 @@
 // The pitch-plunge aerofoil's flutter family with its solves on MPI ranks
-// (distributed/mpi_aerofoil_family.hpp), run by CTest under mpirun on 2 and 3 ranks, against the
+// (distributed/mpi_aerofoil_family.hpp), run by CTest under mpirun on 2, 3 and 4 ranks (4: more
+// ranks than the C-grid's three blocks, which are cut first: aerofoil_on_ranks), against the
 // serial family (models::aerofoil_family) on the very coarse grid, light case:
+//  * aerofoil_on_ranks cuts the grid exactly when there are more ranks than blocks, its local()
+//    and whole() are inverse, and its residual is the serial one (reordered) to rounding;
 //  * the equilibrium (steady flow on the ranks, gathered) is the serial steady equilibrium to the
 //    stopping test's accuracy;
 //  * the inverse-power start at Ubar = 1.66, shift 0.75i is the serial hopf_start_krylov's
@@ -33,6 +36,8 @@
 #include "support/mpi_boundary.hpp"
 #include "support/mpi_test.hpp"
 
+// mpirun ranks: 2 3 4
+
 using namespace aerohopf;
 using aerohopf::test::world_size;
 
@@ -51,6 +56,22 @@ using test::world_rank;
 constexpr int very_coarse = 8;
 
 }  // namespace
+
+TEST(mpi_aerofoil_family, the_grid_is_cut_only_for_more_ranks_than_blocks) {
+  const auto serial = serial_aerofoil_family();
+  const models::aerofoil_system s = serial.system(very_coarse, 0.6);
+  distributed::aerofoil_on_ranks r(s, MPI_COMM_WORLD);
+  EXPECT_EQ(r.cut(), world_size() > 3);
+  // a state with the structure displaced (the grid moves) and a non-uniform flow
+  vec<double> w = s.free_stream_state();
+  for (Eigen::Index i = 0; i < s.flow_size(); ++i) w[i] *= 1 + 0.01 * std::sin(0.37 * double(i));
+  w.tail(4) << 0.01, -0.02, 0.03, 0.01;
+  const vec<double> wl = r.local(w);
+  EXPECT_EQ(r.whole(wl), w);
+  const vec<double> f = s.residual(w, 1.66);
+  const vec<double> fd = r.whole(r.d().residual(wl, 1.66));
+  EXPECT_LT((fd - f).norm(), 1e-12 * f.norm()) << "ranks " << world_size();
+}
 
 TEST(mpi_aerofoil_family, equilibrium_and_start_equal_the_serial_ones) {
   const auto serial = serial_aerofoil_family();

@@ -20,10 +20,12 @@
 // same numbers and every rank takes the same decisions
 // (the reductions are MPI_Allreduce: the same bits everywhere). The grid and the systems are
 // replicated (about 0.55 kB a cell: fine for the aerofoil; a wing wants a per-rank grid).
-// Each level's C-grid is partitioned by whole blocks (partition_blocks: 3 blocks, so 1 to 3
-// ranks), the same cells as the serial numbering, so the boundary equals the serial one to the
-// solvers' tolerances; only the preconditioner (block Jacobi across the ranks) and hence the
-// linear iterations differ.
+// Each level's C-grid is partitioned by whole blocks where it has as many blocks as ranks (3:
+// lower wake, aerofoil, upper wake), in the serial numbering; on more ranks its blocks are cut
+// first (aerofoil_on_ranks: split_for_ranks along the wall-normal direction, the system rebuilt
+// on the cut grid, vectors converted to and from the serial order). Either way the boundary
+// equals the serial one to the solvers' tolerances; only the preconditioner (block Jacobi
+// across the ranks) and hence the linear iterations differ.
 #include <mpi.h>
 
 #include <aerohopf/bifurcation/flutter_boundary.hpp>
@@ -45,9 +47,61 @@
 
 namespace aerohopf::distributed {
 
+/// An aerofoil system on the ranks of comm: on at most as many ranks as its grid has blocks the
+/// system itself, its blocks whole; on more, its grid cut first (split_for_ranks, within 1.1 of
+/// balance, along the wall-normal direction j where a block has 4 cells or more there: the wall
+/// and its near field stay on one rank, as wing_on_ranks) and the system rebuilt on the cut grid
+/// (the same cells in another order; the rigid grid motion moves every point alike). local() and
+/// whole() convert vectors from and to the serial system's order. Collective construction; `s`
+/// must outlive it.
+class aerofoil_on_ranks {
+ public:
+  static constexpr int nv = distributed_aerofoil::nv;
+  static constexpr int normal_axis = 1;
+  aerofoil_on_ranks(const models::aerofoil_system& s, MPI_Comm comm)
+      : ranks_(size_of(comm)), cut_(cut_for(s.flow().grid(), ranks_)), own_(rebuilt(s, cut_)),
+        d_(own_ ? *own_ : s, partition_blocks((own_ ? *own_ : s).flow(), ranks_), comm) {}
+
+  distributed_aerofoil& d() { return d_; }
+  /// The grid is cut (more ranks than the grid's blocks).
+  bool cut() const { return cut_.has_value(); }
+  /// This rank's part of a whole vector of the serial system (real or complex).
+  template <class S>
+  vec<S> local(const vec<S>& whole) const {
+    return cut_ ? d_.local_part(flow::to_split_order(*cut_, whole, nv)) : d_.local_part(whole);
+  }
+  /// The whole vector, in the serial system's order, from every rank's part (collective).
+  template <class S>
+  vec<S> whole(const vec<S>& local) {
+    return cut_ ? flow::from_split_order(*cut_, d_.all_gather(local), nv) : d_.all_gather(local);
+  }
+  /// The grid the ranks share out: cut for more ranks than blocks, else empty (the serial grid).
+  static std::optional<flow::split_grid<2>> cut_for(const flow::multiblock_grid<2>& g, int ranks) {
+    if (static_cast<std::size_t>(ranks) <= g.topology.cells.size()) return std::nullopt;
+    return split_for_ranks(g, ranks, 1.1, normal_axis);
+  }
+
+ private:
+  static int size_of(MPI_Comm comm) {
+    int n = 0;
+    internal::check_mpi(MPI_Comm_size(comm, &n), "MPI_Comm_size");
+    return n;
+  }
+  static std::unique_ptr<models::aerofoil_system> rebuilt(const models::aerofoil_system& s,
+                                                          const std::optional<flow::split_grid<2>>& cut) {
+    if (!cut) return nullptr;
+    return std::make_unique<models::aerofoil_system>(
+        flow::euler_model<2>(cut->grid, s.flow().conditions(), s.flow().options()), s.structure());
+  }
+  int ranks_;
+  std::optional<flow::split_grid<2>> cut_;
+  std::unique_ptr<models::aerofoil_system> own_;  // the system on the cut grid (cut_ only)
+  distributed_aerofoil d_;
+};
+
 class aerofoil_family : public distributed_family_base<models::aerofoil_family> {
  public:
-  /// serial: the family (the same on every rank); comm: its ranks (1 to 3, the C-grid's blocks).
+  /// serial: the family (the same on every rank); comm: its ranks (any number: aerofoil_on_ranks).
   /// Collective: every rank must construct it.
   aerofoil_family(models::aerofoil_family serial, MPI_Comm comm) : distributed_family_base(std::move(serial), comm) {}
 
@@ -77,19 +131,20 @@ class aerofoil_family : public distributed_family_base<models::aerofoil_family> 
     require(std::isfinite(ubar) && ubar != 0.0 && std::isfinite(u0),
             "distributed::aerofoil_family::static_equilibrium_from: Ubar = ", ubar, " from ", u0);
     require_size(w0.size(), s.size(), "distributed::aerofoil_family::static_equilibrium_from", "start state");
-    distributed_aerofoil d(s, partition_blocks(s.flow(), ranks_), comm_);
+    aerofoil_on_ranks r(s, comm_);
+    distributed_aerofoil& d = r.d();
     const std::string who = aerohopf::internal::concat("distributed::aerofoil_family::static_equilibrium at M = ",
                                                        s.flow().conditions().mach, ", Ubar = ", ubar, " on ", ranks_,
                                                        " ranks");
     const vec<double> w = models::aerofoil_family::continue_in_ubar(
-        d.local_part(w0), u0, ubar, who,
+        r.local(w0), u0, ubar, who,
         [&](const vec<double>& wl, double u, std::string& why) -> std::optional<vec<double>> {
           auto r = solve_equilibrium(d, wl, u);
           if (r.converged) return std::move(r.w);
           why = r.reason;
           return std::nullopt;
         });
-    return d.all_gather(w);
+    return r.whole(w);
   }
 
   /// The steady flow of s about the section at rest on the ranks, whole on every rank, the
@@ -97,8 +152,14 @@ class aerofoil_family : public distributed_family_base<models::aerofoil_family> 
   /// max_load: then it is no equilibrium of the coupled system).
   vec<double> steady_flow(const system_type& s, bool check_loads) const {
     vec<double> w = s.free_stream_state();
-    w.head(s.flow_size()) =
-        steady_flow_on_ranks(s.flow(), comm_, serial_.steady_options(), "distributed::aerofoil_family");
+    if (const auto cut = aerofoil_on_ranks::cut_for(s.flow().grid(), ranks_)) {
+      const flow::euler_model<2> m(cut->grid, s.flow().conditions(), s.flow().options());
+      w.head(s.flow_size()) = steady_flow_on_ranks(m, comm_, serial_.steady_options(), "distributed::aerofoil_family");
+      w = flow::from_split_order(*cut, w, aerofoil_on_ranks::nv);
+    } else {
+      w.head(s.flow_size()) =
+          steady_flow_on_ranks(s.flow(), comm_, serial_.steady_options(), "distributed::aerofoil_family");
+    }
     const double mach = s.flow().conditions().mach;
     if (!check_loads) return w;
     const auto [cl, cm] = s.load_coefficients<double>(w);
@@ -114,12 +175,12 @@ class aerofoil_family : public distributed_family_base<models::aerofoil_family> 
   /// its iteration and GMRES counts, the vector whole).
   hopf_point hopf_start(const system_type& s, const vec<double>& w, double ubar, double omega,
                         const hopf_start_krylov_options& so, eigen_pair* info) const {
-    distributed_aerofoil d(s, partition_blocks(s.flow(), ranks_), comm_);
+    aerofoil_on_ranks r(s, comm_);
     distributed_aerofoil::jacobian_rows a, p;
-    d.jacobians(d.local_part(w), ubar, a, p);
+    r.d().jacobians(r.local(w), ubar, a, p);
     const distributed_inverse_power_options io = internal::inverse_power_options_from(so);
-    eigen_pair ep = inverse_power(d, a, so.precondition_exact ? nullptr : &p, {0.0, omega}, io);
-    ep.vector = d.all_gather(ep.vector);
+    eigen_pair ep = inverse_power(r.d(), a, so.precondition_exact ? nullptr : &p, {0.0, omega}, io);
+    ep.vector = r.whole(ep.vector);
     aerohopf::internal::normalise_phase(ep.vector);
     if (info) *info = ep;
     return aerohopf::internal::hopf_point_from(w, ubar, ep);
@@ -129,12 +190,12 @@ class aerofoil_family : public distributed_family_base<models::aerofoil_family> 
   /// on every rank; failures as distributed::solve_hopf (convergence_error on every rank).
   hopf_result solve_hopf(const system_type& s, const hopf_point& guess, const hopf_options& ho,
                          const hopf_krylov_options& ko) const {
-    distributed_aerofoil d(s, partition_blocks(s.flow(), ranks_), comm_);
-    const distributed_hopf_point g{d.local_part(guess.w), guess.mu, guess.omega, d.local_part(guess.p)};
-    const distributed_hopf_result r = distributed::solve_hopf(d, g, internal::hopf_options_from(ho, ko));
-    vec<std::complex<double>> p = d.all_gather(r.point.p);  // collective calls in one order
-    vec<double> w = ho.fixed_equilibrium ? guess.w : d.all_gather(r.point.w);  // fixed: w unchanged
-    return internal::hopf_result_from(r, std::move(w), std::move(p));
+    aerofoil_on_ranks r(s, comm_);
+    const distributed_hopf_point g{r.local(guess.w), guess.mu, guess.omega, r.local(guess.p)};
+    const distributed_hopf_result res = distributed::solve_hopf(r.d(), g, internal::hopf_options_from(ho, ko));
+    vec<std::complex<double>> p = r.whole(res.point.p);  // collective calls in one order
+    vec<double> w = ho.fixed_equilibrium ? guess.w : r.whole(res.point.w);  // fixed: w unchanged
+    return internal::hopf_result_from(res, std::move(w), std::move(p));
   }
 
   /// The inverse powers of the driver's V-g scans (moving equilibrium: the jump's scan and the
@@ -148,24 +209,25 @@ class aerofoil_family : public distributed_family_base<models::aerofoil_family> 
   auto scan_eigen(const system_type& s, const vg_krylov_options& ko) const {
     struct rows_at {
       double ubar = NAN;
-      std::unique_ptr<distributed_aerofoil> d;
+      std::unique_ptr<aerofoil_on_ranks> r;
       distributed_aerofoil::jacobian_rows a, p;
     };
     return [this, &s, ko, cache = std::make_shared<rows_at>()](
                const vec<double>& w, double ubar, std::complex<double> shift, const vec<std::complex<double>>* start,
                const inverse_power_options& power) {
-      if (!cache->d) cache->d = std::make_unique<distributed_aerofoil>(s, partition_blocks(s.flow(), ranks_), comm_);
-      distributed_aerofoil& d = *cache->d;
+      if (!cache->r) cache->r = std::make_unique<aerofoil_on_ranks>(s, comm_);
+      aerofoil_on_ranks& r = *cache->r;
+      distributed_aerofoil& d = r.d();
       if (!(ubar == cache->ubar)) {  // the equilibrium is a function of Ubar
-        d.jacobians(d.local_part(w), ubar, cache->a, cache->p);
+        d.jacobians(r.local(w), ubar, cache->a, cache->p);
         cache->ubar = ubar;
       }
       distributed_inverse_power_options io = internal::inverse_power_options_from(ko, power);
       io.linear.restart = std::max(io.linear.restart, scan_min_restart);
       vec<std::complex<double>> x0;
-      if (start) x0 = d.local_part(*start);
+      if (start) x0 = r.local(*start);
       eigen_pair ep = inverse_power(d, cache->a, &cache->p, shift, io, start ? &x0 : nullptr);
-      ep.vector = d.all_gather(ep.vector);
+      ep.vector = r.whole(ep.vector);
       return ep;
     };
   }

@@ -584,14 +584,16 @@ distributed_hopf_result solve_hopf(D& d, const distributed_hopf_point& guess,
 namespace internal {
 
 /// The distributed Hopf options of a flutter-boundary driver's serial ones (formulation, Newton,
-/// BILU fill, GMRES restart and limit, forcing bound, start refinement): the distributed
-/// families' solve_hopf.
+/// BILU fill, GMRES restart, limit and Gram-Schmidt passes, forcing bound, start refinement):
+/// the distributed families' solve_hopf.
 inline distributed_hopf_options hopf_options_from(const hopf_options& ho, const hopf_krylov_options& ko) {
   distributed_hopf_options o;
   o.hopf = ho;
   o.fill_level = ko.fill_level;
   o.krylov.restart = ko.krylov.restart;
   o.krylov.max_iterations = ko.krylov.max_iterations;
+  o.krylov.reorthogonalize = ko.krylov.reorthogonalize;
+  o.krylov.reorthogonalization_threshold = ko.krylov.reorthogonalization_threshold;
   o.eta_max = ko.eta_max;
   o.start_iterations = ko.start_iterations;
   o.start_tolerance = ko.start_tolerance;
