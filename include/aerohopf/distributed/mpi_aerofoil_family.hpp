@@ -59,7 +59,7 @@ class aerofoil_on_ranks {
   static constexpr int nv = distributed_aerofoil::nv;
   static constexpr int normal_axis = 1;
   aerofoil_on_ranks(const models::aerofoil_system& s, MPI_Comm comm)
-      : ranks_(size_of(comm)), cut_(cut_for(s.flow().grid(), ranks_)), own_(rebuilt(s, cut_)),
+      : ranks_(internal::comm_size(comm)), cut_(cut_for(s.flow().grid(), ranks_)), own_(rebuilt(s, cut_)),
         d_(own_ ? *own_ : s, partition_blocks((own_ ? *own_ : s).flow(), ranks_), comm) {}
 
   distributed_aerofoil& d() { return d_; }
@@ -82,11 +82,6 @@ class aerofoil_on_ranks {
   }
 
  private:
-  static int size_of(MPI_Comm comm) {
-    int n = 0;
-    internal::check_mpi(MPI_Comm_size(comm, &n), "MPI_Comm_size");
-    return n;
-  }
   static std::unique_ptr<models::aerofoil_system> rebuilt(const models::aerofoil_system& s,
                                                           const std::optional<flow::split_grid<2>>& cut) {
     if (!cut) return nullptr;
@@ -139,9 +134,9 @@ class aerofoil_family : public distributed_family_base<models::aerofoil_family> 
     const vec<double> w = models::aerofoil_family::continue_in_ubar(
         r.local(w0), u0, ubar, who,
         [&](const vec<double>& wl, double u, std::string& why) -> std::optional<vec<double>> {
-          auto r = solve_equilibrium(d, wl, u);
-          if (r.converged) return std::move(r.w);
-          why = r.reason;
+          auto eq = solve_equilibrium(d, wl, u);
+          if (eq.converged) return std::move(eq.w);
+          why = eq.reason;
           return std::nullopt;
         });
     return r.whole(w);

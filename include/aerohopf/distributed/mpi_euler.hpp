@@ -48,6 +48,13 @@ inline void check_mpi(int code, const char* call) {
   throw std::runtime_error(aerohopf::internal::concat("MPI: ", call, " failed: ", std::string(text, len)));
 }
 
+/// The number of ranks of comm.
+inline int comm_size(MPI_Comm comm) {
+  int n = 0;
+  check_mpi(MPI_Comm_size(comm, &n), "MPI_Comm_size");
+  return n;
+}
+
 /// p[0 .. n) summed over the ranks of comm, in place (collective).
 inline void sum_over_ranks(MPI_Comm comm, double* p, int n) {
   check_mpi(MPI_Allreduce(MPI_IN_PLACE, p, n, MPI_DOUBLE, MPI_SUM, comm), "MPI_Allreduce");

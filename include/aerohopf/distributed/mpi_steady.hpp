@@ -140,8 +140,7 @@ class distributed_euler_discretisation {
 template <int Dim>
 vec<double> steady_flow_on_ranks(const flow::euler_model<Dim>& model, MPI_Comm comm, const flow::steady_options& o,
                                  const char* who) {
-  int ranks = 0;
-  internal::check_mpi(MPI_Comm_size(comm, &ranks), "MPI_Comm_size");
+  const int ranks = internal::comm_size(comm);
   flow::euler_model<Dim> m = model;
   distributed_euler<Dim> d(m, partition_blocks(m, ranks), comm);
   distributed_euler_discretisation<Dim> disc(m, d);

@@ -50,9 +50,9 @@ class wing_on_ranks {
   /// the section, the longest axis; 368 serially).
   static constexpr int normal_axis = 1;
   wing_on_ranks(const models::wing_system& s, MPI_Comm comm, int cut_axis = normal_axis)
-      : cut_(split_for_ranks(s.flow().grid(), size_of(comm), 1.1, cut_axis)),
+      : cut_(split_for_ranks(s.flow().grid(), internal::comm_size(comm), 1.1, cut_axis)),
         sys_(models::split_wing_system(s, cut_)),
-        d_(sys_, partition_blocks(sys_.flow(), size_of(comm)), comm) {}
+        d_(sys_, partition_blocks(sys_.flow(), internal::comm_size(comm)), comm) {}
 
   distributed_wing& d() { return d_; }
   const flow::split_grid<3>& cut() const { return cut_; }
@@ -69,11 +69,6 @@ class wing_on_ranks {
   }
 
  private:
-  static int size_of(MPI_Comm comm) {
-    int n = 0;
-    internal::check_mpi(MPI_Comm_size(comm, &n), "MPI_Comm_size");
-    return n;
-  }
   flow::split_grid<3> cut_;
   models::wing_system sys_;
   distributed_wing d_;
