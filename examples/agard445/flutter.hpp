@@ -200,8 +200,9 @@ std::vector<boundary_run> boundaries(const flutter_options& o, const std::filesy
   std::vector<int> strides = o.strides;
   if (o.vg_stride) strides.push_back(o.vg_stride);
   for (double zeta : o.damping_percent) {
-    const models::wing_family serial(wing, grid, strides, modes, Eigen::VectorXd::Constant(1, zeta / 100),
-                                     tunnel_schedule());
+    models::wing_family serial(wing, grid, strides, modes, Eigen::VectorXd::Constant(1, zeta / 100),
+                               tunnel_schedule());
+    if (o.verbose) serial.steady_options().log = log;  // a line per steady step (rank 0 only on the ranks)
     decltype(auto) family = wrap(serial);  // a reference to `serial` itself, or a new family
     const flutter_boundary* coarser = nullptr;
     for (int s : o.strides) {

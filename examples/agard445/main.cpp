@@ -22,7 +22,7 @@
 //   --machs LIST   Mach numbers of the boundaries (default 0.499,0.678,0.901,0.96, the experiment's)
 //   --vg L         V-g / V-f diagram on level L (default none)   --vg-mach M (default 0.96)
 //   --march L      time-marching verification at 0.95 / 1.05 mu* on level L at the V-g Mach number
-//   --verbose      a line per Newton iteration of the boundaries
+//   --verbose      a line per Newton iteration of the boundaries and per step of their steady solves
 // Outputs under out_dir (default out/agard445):
 //   modes.csv          mode,frequency_hz,generalised_mass  (generalised mass of the mode scaled to a
 //                      largest deflection of 1 m, kg; the shapes are mass-normalised otherwise)

@@ -55,6 +55,13 @@ inline int comm_size(MPI_Comm comm) {
   return n;
 }
 
+/// This process's rank in comm.
+inline int comm_rank(MPI_Comm comm) {
+  int r = 0;
+  check_mpi(MPI_Comm_rank(comm, &r), "MPI_Comm_rank");
+  return r;
+}
+
 /// p[0 .. n) summed over the ranks of comm, in place (collective).
 inline void sum_over_ranks(MPI_Comm comm, double* p, int n) {
   check_mpi(MPI_Allreduce(MPI_IN_PLACE, p, n, MPI_DOUBLE, MPI_SUM, comm), "MPI_Allreduce");
@@ -85,9 +92,7 @@ void collective(MPI_Comm comm, const char* what, F&& f) {
   } catch (...) {
     error = std::current_exception();
   }
-  int rank = 0;
-  check_mpi(MPI_Comm_rank(comm, &rank), "MPI_Comm_rank");
-  const int mine = error ? rank : -1;
+  const int mine = error ? comm_rank(comm) : -1;
   int first = -1;
   check_mpi(MPI_Allreduce(&mine, &first, 1, MPI_INT, MPI_MAX, comm), "MPI_Allreduce");
   if (error) std::rethrow_exception(error);
@@ -100,8 +105,7 @@ void collective(MPI_Comm comm, const char* what, F&& f) {
 /// rank (as internal::collective: the others would otherwise wait in the next collective call).
 template <class F>
 void on_root(MPI_Comm comm, const char* what, F&& fn) {
-  int rank = 0;
-  internal::check_mpi(MPI_Comm_rank(comm, &rank), "MPI_Comm_rank");
+  const int rank = internal::comm_rank(comm);
   internal::collective(comm, what, [&] {
     if (rank == 0) fn();
   });

@@ -136,7 +136,8 @@ class distributed_euler_discretisation {
 /// The steady flow of `model` from the free stream on the ranks of comm (its blocks partitioned
 /// by partition_blocks: the grid must have at least as many blocks as ranks), whole on every rank
 /// in the model's cell order; convergence_error (every rank) naming `who`, the Mach number and
-/// the ranks if it does not converge. The distributed flutter families' equilibria.
+/// the ranks if it does not converge. The distributed flutter families' equilibria. Progress
+/// (o.log: a line per step with the global residual) is written by rank 0 only.
 template <int Dim>
 vec<double> steady_flow_on_ranks(const flow::euler_model<Dim>& model, MPI_Comm comm, const flow::steady_options& o,
                                  const char* who) {
@@ -145,7 +146,9 @@ vec<double> steady_flow_on_ranks(const flow::euler_model<Dim>& model, MPI_Comm c
   distributed_euler<Dim> d(m, partition_blocks(m, ranks), comm);
   distributed_euler_discretisation<Dim> disc(m, d);
   vec<double> wf = d.local_part(m.free_stream_vector());
-  const auto r = flow::solve_steady(disc, wf, o);
+  flow::steady_options ro = o;
+  if (internal::comm_rank(comm) != 0) ro.log = nullptr;
+  const auto r = flow::solve_steady(disc, wf, ro);
   if (!r.converged)
     throw convergence_error(aerohopf::internal::concat(who, ": the steady flow at M = ", model.conditions().mach,
                                                        " on ", ranks, " ranks did not converge (", r.steps,
