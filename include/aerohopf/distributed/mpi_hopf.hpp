@@ -583,6 +583,15 @@ distributed_hopf_result solve_hopf(D& d, const distributed_hopf_point& guess,
 
 namespace internal {
 
+/// GMRES's restart, iteration limit and Gram-Schmidt passes from a serial caller's options (the
+/// tolerance is the caller's forcing or its own, set apart).
+inline void copy_gmres_shape(const krylov_options& from, krylov_options& to) {
+  to.restart = from.restart;
+  to.max_iterations = from.max_iterations;
+  to.reorthogonalize = from.reorthogonalize;
+  to.reorthogonalization_threshold = from.reorthogonalization_threshold;
+}
+
 /// The distributed Hopf options of a flutter-boundary driver's serial ones (formulation, Newton,
 /// BILU fill, GMRES restart, limit and Gram-Schmidt passes, forcing bound, start refinement):
 /// the distributed families' solve_hopf.
@@ -590,10 +599,7 @@ inline distributed_hopf_options hopf_options_from(const hopf_options& ho, const 
   distributed_hopf_options o;
   o.hopf = ho;
   o.fill_level = ko.fill_level;
-  o.krylov.restart = ko.krylov.restart;
-  o.krylov.max_iterations = ko.krylov.max_iterations;
-  o.krylov.reorthogonalize = ko.krylov.reorthogonalize;
-  o.krylov.reorthogonalization_threshold = ko.krylov.reorthogonalization_threshold;
+  copy_gmres_shape(ko.krylov, o.krylov);
   o.eta_max = ko.eta_max;
   o.start_iterations = ko.start_iterations;
   o.start_tolerance = ko.start_tolerance;
@@ -602,28 +608,28 @@ inline distributed_hopf_options hopf_options_from(const hopf_options& ho, const 
   return o;
 }
 
-/// The distributed inverse-power options of a driver's Hopf start (hopf_start_krylov's).
-inline distributed_inverse_power_options inverse_power_options_from(const hopf_start_krylov_options& so) {
+/// The distributed inverse-power options of a serial caller's: the eigen-residual target
+/// `power`, the BILU fill and the GMRES tolerance, restart, limit and Gram-Schmidt passes.
+inline distributed_inverse_power_options inverse_power_options_from(const inverse_power_options& power, int fill_level,
+                                                                    const krylov_options& krylov) {
   distributed_inverse_power_options io;
-  io.power = so.inverse_power;
-  io.fill_level = so.fill_level;
-  io.linear.relative_tolerance = so.krylov.relative_tolerance;
-  io.linear.restart = so.krylov.restart;
-  io.linear.max_iterations = so.krylov.max_iterations;
+  io.power = power;
+  io.fill_level = fill_level;
+  io.linear.relative_tolerance = krylov.relative_tolerance;
+  copy_gmres_shape(krylov, io.linear);
   return io;
 }
 
-/// The distributed inverse-power options of a V-g scan's (vg_krylov_options: BILU fill, GMRES
-/// tolerance, restart and limit; the eigen-residual target in `power`).
+/// The distributed inverse-power options of a driver's Hopf start (hopf_start_krylov's).
+inline distributed_inverse_power_options inverse_power_options_from(const hopf_start_krylov_options& so) {
+  return inverse_power_options_from(so.inverse_power, so.fill_level, so.krylov);
+}
+
+/// The distributed inverse-power options of a V-g scan's (vg_krylov_options; the eigen-residual
+/// target in `power`).
 inline distributed_inverse_power_options inverse_power_options_from(const vg_krylov_options& ko,
                                                                     const inverse_power_options& power) {
-  distributed_inverse_power_options io;
-  io.power = power;
-  io.fill_level = ko.fill_level;
-  io.linear.relative_tolerance = ko.krylov.relative_tolerance;
-  io.linear.restart = ko.krylov.restart;
-  io.linear.max_iterations = ko.krylov.max_iterations;
-  return io;
+  return inverse_power_options_from(power, ko.fill_level, ko.krylov);
 }
 
 /// The serial hopf_result of a distributed one, with the whole w and p (gathered by the

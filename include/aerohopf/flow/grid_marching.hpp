@@ -36,11 +36,17 @@ using point2 = std::array<double, 2>;
 /// far_field. first_reference (same size as curve, or empty) replaces the curve in the FIRST
 /// step's normals and smoothing only: a zero-thickness section (a wing's cut beyond its tip) has
 /// coincident points whose own tangents are undefined; a thin section of the same shape gives
-/// them their normals.
+/// them their normals. max_shift > 0 bounds each layer's tangential redistribution of the wake's
+/// points (the first and last wake_points + 1 of the curve) to max_shift times its step, so no
+/// wake line leans by more than atan(max_shift) from the marching direction over one layer; 0:
+/// unbounded. Where the tangential spacing is many steps long (a far wake of thin layers) the
+/// unbounded redistribution leans the lines nearly along the layer and the cells next to the
+/// wake cut become slivers whose faces all run with the flow.
 inline std::vector<std::vector<point2>> march_c_layers(const std::vector<point2>& curve,
                                                        const std::vector<point2>& first_reference, int nj,
                                                        double first_height, double far_field, double smoothing,
-                                                       int redistribution_passes) {
+                                                       int redistribution_passes, double max_shift = 0.0,
+                                                       int wake_points = 0) {
   const int ni = static_cast<int>(curve.size());
   require(ni >= 3 && nj >= 2, "march_c_layers: need at least 3 points along the curve and 2 layers (got ", ni, ", ",
           nj, ")");
@@ -121,6 +127,7 @@ inline std::vector<std::vector<point2>> march_c_layers(const std::vector<point2>
     // Tangential redistribution: move each point along the layer towards the mid-point of its
     // neighbours (tangential component only), more strongly away from the wall.
     const double omega = std::min(0.5, 0.05 * j);
+    const std::vector<point2> marched = max_shift > 0 ? cur : std::vector<point2>{};
     for (int s = 0; s < redistribution_passes; ++s) {
       for (int i = 1; i < ni - 1; ++i) {
         const auto u = static_cast<std::size_t>(i);
@@ -133,6 +140,13 @@ inline std::vector<std::vector<point2>> march_c_layers(const std::vector<point2>
       }
       for (int i = 1; i < ni - 1; ++i) cur[static_cast<std::size_t>(i)] = tmp[static_cast<std::size_t>(i)];
     }
+    if (max_shift > 0)  // the wake lines' lean over this layer at most atan(max_shift)
+      for (int i = 1; i < ni - 1; ++i) {
+        if (i > wake_points && i < ni - 1 - wake_points) continue;
+        const auto u = static_cast<std::size_t>(i);
+        const double dx = cur[u][0] - marched[u][0], dy = cur[u][1] - marched[u][1], d = std::hypot(dx, dy);
+        if (d > max_shift * h) cur[u] = {marched[u][0] + dx * (max_shift * h / d), marched[u][1] + dy * (max_shift * h / d)};
+      }
   }
   return layer;
 }
