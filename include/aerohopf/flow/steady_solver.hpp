@@ -57,8 +57,9 @@ struct steady_options {
   double exact_switch_drop = 1e-3;   // exact Jacobian once ||R||/||R_0|| < this (0: never)
   // With the exact Jacobian (Newton), fail as stalled when stall_steps steps in a row have not
   // brought ||R|| below stall_factor times its value before them (0: never); the message names
-  // the cell with the largest residual. Off by default: the AGARD medium grid at M = 0.678 sits
-  // at ||R|| ~ 1.5e-5 for more than ten Newton steps (GMRES at its limit) and then converges.
+  // the cell with the largest residual. Off by default: the AGARD medium grid with unbounded wake
+  // lines (wing_grid_options::max_shift = 0) at M = 0.678 sat at ||R|| ~ 1.5e-5 for more than
+  // ten Newton steps (GMRES at its limit) and then converged.
   int stall_steps = 0;
   double stall_factor = 0.5;
   std::ostream* log = nullptr;        // progress line per step when set
