@@ -244,8 +244,11 @@ std::vector<boundary_run> boundaries(const flutter_options& o, const std::filesy
         if (!r.b.complete) std::printf("  boundary incomplete: %s\n", r.b.stop_reason.c_str());
         for (const auto& p : r.b.points)  // the flutter mode at M = 0.96
           if (std::abs(p.mach - 0.96) < 1e-9) {
-            models::write_flutter_mode_vtk(serial.system(s, p.mach), p.point,
-                                           (out / ("flutter_mode_" + name + "_" + damping_tag(zeta) + "_M0.96")).string());
+            const models::flutter_mode_frames f = models::write_flutter_mode_vtk(
+                serial.system(s, p.mach), p.point, (out / ("flutter_mode_" + name + "_" + damping_tag(zeta) + "_M0.96")).string());
+            if (f.displacement < 0.05)
+              std::printf("  flutter mode VTK at M = 0.96: largest deflection %.2g root chords (0.05 made the flow unphysical)\n",
+                          f.displacement);
           }
         const flutter_boundary_costs c = boundary_costs(r.b, o.machs);
         std::printf("  %zu points in %.1f s; Hopf work per steady solve %.2f (continued points), %.2f (all work beyond "

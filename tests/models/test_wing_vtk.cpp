@@ -65,6 +65,26 @@ TEST(wing_vtk, peak_displacement_is_exact_and_frames_are_symmetric) {
   EXPECT_LT((f.states[1] + f.states[3] - 2 * h.w).norm(), 1e-14 * f.states[1].norm());
 }
 
+// A flow part too large for the asked displacement (density perturbation 500 in one cell against
+// about 1): the scale is halved until every frame is physical, the frames stay symmetric.
+TEST(wing_vtk, a_flow_part_too_large_for_the_displacement_is_scaled_down) {
+  const wing_system s = tiny_wing();
+  hopf_point h = synthetic_point(s);
+  EXPECT_DOUBLE_EQ(models::flutter_mode_states(s, h, 0.05, 4).displacement, 0.05);
+  h.p[5 * 7] = std::complex<double>(400.0, -300.0);
+  const models::flutter_mode_frames f = models::flutter_mode_states(s, h, 0.05, 4);
+  EXPECT_LT(f.displacement, 0.05) << "eps " << f.eps << " peak " << f.peak_displacement;
+  EXPECT_GT(f.displacement, 0.05 / 4096);
+  EXPECT_DOUBLE_EQ(f.displacement, f.eps * f.peak_displacement);
+  for (const auto& w : f.states) EXPECT_FALSE(s.flow().first_nonphysical_cell(w.data()));
+  EXPECT_TRUE(s.flow().first_nonphysical_cell(vec<double>(h.w + (2 * f.eps * h.p).real()).data()) ||
+              s.flow().first_nonphysical_cell(vec<double>(h.w - (2 * f.eps * h.p).real()).data()) ||
+              s.flow().first_nonphysical_cell(vec<double>(h.w + (2 * f.eps * std::complex<double>(0, 1) * h.p).real()).data()) ||
+              s.flow().first_nonphysical_cell(vec<double>(h.w - (2 * f.eps * std::complex<double>(0, 1) * h.p).real()).data()))
+      << "twice the scale is unphysical in some frame (the halving stopped at the first physical one)";
+  EXPECT_LT((f.states[0] + f.states[2] - 2 * h.w).norm(), 1e-14 * f.states[0].norm());
+}
+
 TEST(wing_vtk, writes_the_deflected_surface_per_phase) {
   const wing_system s = tiny_wing();
   const hopf_point h = synthetic_point(s);

@@ -7,7 +7,10 @@
 // chords). The displacement of a grid point is linear in the modal coordinates, d(phi) =
 // Re(e^{i phi} z) with z = d_r + i d_i the point's complex displacement (d_r, d_i: the motion of
 // Re p_a, Im p_a), and max over phi of |Re(e^{i phi} z)|^2 = (|z|^2 + |z . z|) / 2 (z . z the
-// bilinear product): the exact peak, not a sampled one.
+// bilinear product): the exact peak, not a sampled one. Where that scale would make a frame's flow
+// state unphysical somewhere (the mode's flow part is large where the linear perturbation of a
+// thin far-wake cell exceeds its state), eps is halved until every frame is physical, and the
+// frames' displacement says so.
 #include <algorithm>
 #include <cmath>
 #include <complex>
@@ -25,11 +28,13 @@ namespace aerohopf::models {
 struct flutter_mode_frames {
   double eps = 0;                   ///< the scale of p
   double peak_displacement = 0;     ///< of the unscaled p over the cycle, root chords
+  double displacement = 0;          ///< of the frames (eps * peak_displacement): the one asked for, or less
   std::vector<vec<double>> states;  ///< w0 + eps Re(e^{2 pi i k / phases} p), k = 0 .. phases - 1
 };
 
 /// The states of the flutter mode of h at `phases` phases, scaled to a largest grid displacement
-/// of `displacement` root chords (input_error if p does not move the wing or the sizes differ).
+/// of `displacement` root chords, or less where that makes a frame unphysical (file comment);
+/// input_error if p does not move the wing or the sizes differ.
 inline flutter_mode_frames flutter_mode_states(const wing_system& s, const hopf_point& h, double displacement = 0.05,
                                                int phases = 4) {
   const char* who = "flutter_mode_states";
@@ -56,11 +61,21 @@ inline flutter_mode_frames flutter_mode_states(const wing_system& s, const hopf_
   f.peak_displacement = std::sqrt(peak2);
   require(f.peak_displacement > 0 && std::isfinite(f.peak_displacement), who,
           ": the eigenvector does not move the wing (largest displacement ", f.peak_displacement, ")");
+  require(!s.flow().first_nonphysical_cell(h.w.data()), who, ": the Hopf point's equilibrium is not a physical state");
   f.eps = displacement / f.peak_displacement;
-  for (int k = 0; k < phases; ++k) {
-    const std::complex<double> rot = std::polar(f.eps, 2 * std::numbers::pi * k / phases);
-    f.states.push_back(h.w + vec<double>((rot * h.p).real()));
+  for (int halvings = 0;; ++halvings) {
+    f.states.clear();
+    bool physical = true;
+    for (int k = 0; k < phases && physical; ++k) {
+      const std::complex<double> rot = std::polar(f.eps, 2 * std::numbers::pi * k / phases);
+      f.states.push_back(h.w + vec<double>((rot * h.p).real()));
+      physical = !s.flow().first_nonphysical_cell(f.states.back().data());
+    }
+    if (physical) break;
+    require(halvings < 60, who, ": no scale of the eigenvector keeps the flow physical");
+    f.eps *= 0.5;
   }
+  f.displacement = f.eps * f.peak_displacement;
   return f;
 }
 
