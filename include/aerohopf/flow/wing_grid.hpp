@@ -55,11 +55,11 @@ struct wing_grid_options {
   double smoothing = 8.0;
   int redistribution_passes = 20;
   /// Bound of each layer's tangential redistribution in the wake, in steps
-  /// (internal::march_c_layers; 0: none): the wake's lines lean at most 45 deg per layer. Unbounded, the far wake's thin layers (the
-  /// AGARD medium grid's cells at the cut 2.6 root chords long and 0.004 thick) leaned their
-  /// i = const lines almost along the cut, and the medium steady flow at M = 0.96 stalled in
-  /// Newton (GMRES at a relative residual of 0.92 after 1,000 iterations); bounded, it converges
-  /// in 24 steps.
+  /// (internal::march_c_layers; 0: none): the wake's lines lean at most 45 deg per layer.
+  /// Unbounded, the far wake's thin layers (the AGARD medium grid's cells at the cut 2.6 root
+  /// chords long and 0.004 thick) leaned their i = const lines almost along the cut, and the
+  /// medium steady flow at M = 0.96 stalled in Newton (GMRES at a relative residual of 0.92
+  /// after 1,000 iterations); bounded, it converges in 24 steps.
   double max_shift = 1.0;
   int multiple = 8;          ///< every cell count must divide by this (coarsest stride)
 };
