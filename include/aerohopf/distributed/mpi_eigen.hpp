@@ -43,8 +43,7 @@ struct distributed_vectors {
     return s;
   }
   std::complex<double> largest_entry(const vec<std::complex<double>>& x) const {
-    int rank = 0;
-    internal::check_mpi(MPI_Comm_rank(comm, &rank), "MPI_Comm_rank");
+    const int rank = internal::comm_rank(comm);
     struct {
       double value;
       int rank;

@@ -121,9 +121,8 @@ class distributed_euler {
   /// Collective.
   distributed_euler(const flow::euler_model<Dim>& model, const block_partition& part, MPI_Comm comm)
       : model_(model), comm_(comm), part_(part) {
-    internal::check_mpi(MPI_Comm_rank(comm_, &rank_), "MPI_Comm_rank");
-    int size = 0;
-    internal::check_mpi(MPI_Comm_size(comm_, &size), "MPI_Comm_size");
+    rank_ = internal::comm_rank(comm_);
+    const int size = internal::comm_size(comm_);
     internal::collective(comm_, "distributed_euler", [&] {
       require(part.ranks == size, "distributed_euler: the partition has ", part.ranks, " ranks, the communicator ",
               size);

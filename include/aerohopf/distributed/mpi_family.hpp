@@ -46,8 +46,8 @@ class distributed_family_base {
  protected:
   /// Collective: every rank must construct it.
   distributed_family_base(Serial serial, MPI_Comm comm) : serial_(std::move(serial)), comm_(comm) {
-    internal::check_mpi(MPI_Comm_size(comm_, &ranks_), "MPI_Comm_size");
-    internal::check_mpi(MPI_Comm_rank(comm_, &rank_), "MPI_Comm_rank");
+    ranks_ = internal::comm_size(comm_);
+    rank_ = internal::comm_rank(comm_);
   }
 
   Serial serial_;
