@@ -135,7 +135,7 @@ double spmv_bytes(const M& a) {
 // sweep (on the out-of-cache matrices the vector is evicted by the factor stream in between).
 template <class S, int B>
 double ilu_apply_bytes(const block_ilu<S, B>& m) {
-  return double(m.nonzero_blocks()) * (B * B * sizeof(S) + sizeof(int)) + double(m.block_rows()) * 2 * sizeof(int) +
+  return double(m.factor_bytes()) + double(m.nonzero_blocks()) * sizeof(int) + double(m.block_rows()) * 2 * sizeof(int) +
          4.0 * m.rows() * sizeof(S);
 }
 
@@ -226,6 +226,9 @@ void bench_spmv_shifted_real(benchmark::State& state, std::function<problem<B>&(
 // ---- BILU phases -------------------------------------------------------------------------------
 enum class form { real, complex, real2n };
 const char* form_name(form f) { return f == form::real ? "real" : f == form::complex ? "complex" : "real2n_interleaved"; }
+/// The form's name with "_f32" where the BILU factors are kept in single precision
+/// (block_ilu_options::single_precision_factors).
+std::string form_name(form f, bool single) { return std::string(form_name(f)) + (single ? "_f32" : ""); }
 
 template <int B, class S>
 const block_sparse_matrix<S, B>& pick(problem<B>& p, form f) {
@@ -241,11 +244,13 @@ coupling_filter filter_for(problem<B>& p, int method, form f) {
 
 // phase: 0 symbolic, 1 numeric, 2 apply
 template <int B, class S>
-void bench_ilu(benchmark::State& state, std::function<problem<B>&()> get, form f, int method, int fill, int phase) {
+void bench_ilu(benchmark::State& state, std::function<problem<B>&()> get, form f, int method, int fill, int phase,
+               bool single = false) {
   auto& p = get();
   const auto& m = pick<B, S>(p, f);
   block_ilu_options o;
   o.fill_level = fill;
+  o.single_precision_factors = single;
   o.filter = filter_for(p, method, f);
   block_ilu<S, B> ilu(o);
   if (phase == 0) {
@@ -276,7 +281,7 @@ void bench_ilu(benchmark::State& state, std::function<problem<B>&()> get, form f
 // the preconditioner is the same complex BILU(k) of the assembled matrix.
 template <int B, class S>
 void bench_solve(benchmark::State& state, std::function<problem<B>&()> get, form f, int method, int fill,
-                 krylov_method km, double rtol, bool real_operator = false) {
+                 krylov_method km, double rtol, bool real_operator = false, bool single = false) {
   auto& p = get();
   const auto& m = pick<B, S>(p, f);
   // right-hand side: a smooth complex field (the same for both forms)
@@ -291,6 +296,7 @@ void bench_solve(benchmark::State& state, std::function<problem<B>&()> get, form
     block_ilu_options o;
     o.fill_level = fill;
     o.filter = filter_for(p, method, f);
+    o.single_precision_factors = single;
     block_ilu<S, B> ilu(o);
     krylov_report rep;
     double t1 = t0;
@@ -512,6 +518,15 @@ void register_matrix_kernels(const std::string& mname, std::function<problem<B>&
             ->Unit(benchmark::kMillisecond)
             ->MinTime(phase == 2 ? 0.3 : 0.1);
       }
+      // the same apply with the factors in single precision (half the factor bytes)
+      auto fs = [get, f, k](benchmark::State& s) {
+        if (f == form::complex) bench_ilu<B, cd>(s, get, f, 1, k, 2, true);
+        else bench_ilu<B, double>(s, get, f, 1, k, 2, true);
+      };
+      benchmark::RegisterBenchmark(nm({"ilu", mname, bs, form_name(f, true), "1", std::to_string(k), "bilu_apply"}).c_str(),
+                                   fs)
+          ->Unit(benchmark::kMillisecond)
+          ->MinTime(0.3);
     }
   }
 }
@@ -537,12 +552,12 @@ void register_storage(const std::string& mname, std::function<problem<B>&()> get
 
 template <int B>
 void register_solve(const std::string& mname, std::function<problem<B>&()> get, form f, int method, int k,
-                    krylov_method km, double tol, bool real_operator = false) {
+                    krylov_method km, double tol, bool real_operator = false, bool single = false) {
   auto fn = [=](benchmark::State& s) {
-    if (f == form::complex) bench_solve<B, cd>(s, get, f, method, k, km, tol, real_operator);
-    else bench_solve<B, double>(s, get, f, method, k, km, tol);
+    if (f == form::complex) bench_solve<B, cd>(s, get, f, method, k, km, tol, real_operator, single);
+    else bench_solve<B, double>(s, get, f, method, k, km, tol, false, single);
   };
-  benchmark::RegisterBenchmark(nm({"solve", mname, std::to_string(B), form_name(f), std::to_string(method),
+  benchmark::RegisterBenchmark(nm({"solve", mname, std::to_string(B), form_name(f, single), std::to_string(method),
                                    std::to_string(k),
                                    std::string(solver_name(km)) + (real_operator ? "_realA_" : "_") + tol_name(tol)})
                                    .c_str(),
@@ -628,6 +643,10 @@ void register_all() {
         register_solve<5>(ga.name(), geta, form::complex, 1, k, km, tol, true);
   for (int method = 2; method <= 3; ++method)
     register_solve<5>(ga.name(), geta, form::complex, method, 1, krylov_method::gmres, 1e-8);
+  // the Hopf solves' configuration with single-precision factors (beside the double ones above)
+  for (double tol : {1e-2, 1e-8})
+    for (int k = 0; k <= 2; ++k)
+      register_solve<5>(ga.name(), geta, form::complex, 1, k, krylov_method::gmres, tol, true, true);
   register_peers<5>(ga.name(), geta, {form::complex, form::real2n}, 1e-8, {0, 1, 2}, true);
   register_peers<5>(ga.name(), geta, {form::real2n}, 1e-2, {0, 1});
 

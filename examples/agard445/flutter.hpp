@@ -251,9 +251,13 @@ std::vector<boundary_run> boundaries(const flutter_options& o, const std::filesy
                           f.displacement);
           }
         const flutter_boundary_costs c = boundary_costs(r.b, o.machs);
-        std::printf("  %zu points in %.1f s; Hopf work per steady solve %.2f (continued points), %.2f (all work beyond "
-                    "one steady solve per listed Mach number)\n",
-                    r.b.points.size(), r.seconds, c.hopf_per_steady, c.hopf_per_steady_listed);
+        if (c.continued == 0)  // the first point alone: its cost is in the table above
+          std::printf("  %zu point(s) in %.1f s; no continued points, so no Hopf work per steady solve\n",
+                      r.b.points.size(), r.seconds);
+        else
+          std::printf("  %zu points in %.1f s; Hopf work per steady solve %.2f (continued points), %.2f (all work "
+                      "beyond one steady solve per listed Mach number)\n",
+                      r.b.points.size(), r.seconds, c.hopf_per_steady, c.hopf_per_steady_listed);
         std::fflush(stdout);
       });
       runs.push_back(std::move(r));

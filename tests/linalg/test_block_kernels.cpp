@@ -1,6 +1,7 @@
 // Block-row kernels of SpMV and the BILU sweeps (linalg/block_kernels.hpp) against Eigen's dense
 // products, for the block sizes with hand-written kernels (4, 5) and one without (3), real and
-// complex, both signs, rows of 0..9 blocks with repeated and scattered columns. This file is
+// complex, both signs, rows of 0..9 blocks with repeated and scattered columns; blocks stored in
+// single precision against the same values widened to double. This file is
 // compiled twice when AEROHOPF_NATIVE is on: with -march=native (AVX2 + FMA kernels where the CPU
 // has them) and without (SSE2 / plain loops), so both paths are checked on every machine.
 #include <gtest/gtest.h>
@@ -102,7 +103,63 @@ void check_real_complex_rows() {
   }
 }
 
+// blocks stored in single precision (the BILU factors' option), sums in double: the kernel must
+// give the double product of the stored values widened exactly, not a float product
+template <class S, int B, int Sign>
+void check_single_precision_rows() {
+  using F = internal::single_precision_t<S>;
+  std::mt19937 gen(777 + B * 10 + Sign);
+  const int n_seg = 7;
+  const std::vector<S> x = random_values<S>(gen, n_seg * B);
+  std::uniform_int_distribution<int> col(0, n_seg - 1);
+  for (int count = 0; count <= 6; ++count) {
+    const std::vector<S> a = random_values<S>(gen, std::size_t(count) * B * B);
+    std::vector<F> af(a.size());
+    std::vector<S> widened(a.size());
+    for (std::size_t e = 0; e < a.size(); ++e) {
+      af[e] = F(a[e]);
+      widened[e] = S(af[e]);
+    }
+    std::vector<int> cols(count);
+    for (auto& c : cols) c = col(gen);
+    std::vector<S> acc = random_values<S>(gen, B), acc_wide = acc;
+    internal::block_row_gemv<Sign, B>(af.data(), cols.data(), count, x.data(), acc.data());
+    internal::block_row_gemv<Sign, B>(widened.data(), cols.data(), count, x.data(), acc_wide.data());
+    double change = 0.0;
+    for (int r = 0; r < B; ++r)
+      EXPECT_LE(std::abs(acc[r] - acc_wide[r]), 1e-15 * (1.0 + std::abs(acc_wide[r]))) << "B " << B << " row " << r;
+    // and the rounding to float really happened (the stored values differ from a's)
+    for (std::size_t e = 0; e < a.size(); ++e) change = std::max(change, std::abs(widened[e] - a[e]));
+    if (count > 0) {
+      EXPECT_GT(change, 0.0);
+    }
+  }
+  const std::vector<S> a1 = random_values<S>(gen, B * B), x1 = random_values<S>(gen, B);
+  std::vector<F> a1f(a1.size());
+  std::vector<S> a1w(a1.size());
+  for (std::size_t e = 0; e < a1.size(); ++e) a1w[e] = S(a1f[e] = F(a1[e]));
+  std::vector<S> y = random_values<S>(gen, B), yw = y;
+  internal::block_gemv<Sign, B>(a1f.data(), x1.data(), y.data());
+  internal::block_gemv<Sign, B>(a1w.data(), x1.data(), yw.data());
+  for (int r = 0; r < B; ++r) EXPECT_LE(std::abs(y[r] - yw[r]), 1e-15 * (1.0 + std::abs(yw[r])));
+}
+
+template <class S, int B>
+void check_single_precision_both_signs() {
+  check_single_precision_rows<S, B, 1>();
+  check_single_precision_rows<S, B, -1>();
+}
+
 }  // namespace
+
+TEST(block_kernels, single_precision_blocks_give_the_double_product_of_their_values) {
+  check_single_precision_both_signs<double, 3>();
+  check_single_precision_both_signs<double, 4>();
+  check_single_precision_both_signs<double, 5>();
+  check_single_precision_both_signs<cd, 3>();
+  check_single_precision_both_signs<cd, 4>();
+  check_single_precision_both_signs<cd, 5>();
+}
 
 TEST(block_kernels, real_matrix_complex_vector_rows_match_eigen) {
   check_real_complex_rows<3>();

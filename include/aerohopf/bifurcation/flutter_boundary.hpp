@@ -509,6 +509,7 @@ moving_scan_result moving_vg_scan(const F& f, const typename F::system_type& s, 
 inline hopf_start_krylov_options krylov_start_options(const flutter_boundary_options& o, double tolerance) {
   hopf_start_krylov_options so;
   so.fill_level = o.fill_level;
+  so.single_precision_factors = o.krylov.single_precision_factors;
   so.krylov.restart = o.start_restart;
   so.krylov.relative_tolerance = 0.1 * tolerance;
   so.inverse_power.tolerance = tolerance;

@@ -360,6 +360,7 @@ eigen_pair inverse_power(distributed_bordered<Dim>& d, const bordered_rows<Dim>&
 
   block_ilu_options io;
   io.fill_level = opt.fill_level;
+  io.single_precision_factors = opt.single_precision_factors;
   io.context = "distributed inverse power (aeroelastic): block-Jacobi BILU of P - sigma I";
   basic_distributed_bordered_preconditioner<Dim, C> pc(io);
   pc.compute(d, pre ? *pre : a, shift);

@@ -64,6 +64,7 @@ struct distributed_inverse_power_options {
   inverse_power_options power;  ///< tolerance on ||A x - lambda x|| / max(1, |lambda|), iterations
   krylov_options linear;        ///< each shifted solve (relative tolerance 1e-9 by default: file comment)
   int fill_level = 0;           ///< k of the block-Jacobi BILU(k)
+  bool single_precision_factors = false;  ///< block_ilu_options::single_precision_factors
   distributed_inverse_power_options() {
     linear.relative_tolerance = 1e-9;
     linear.max_iterations = 500;
@@ -99,10 +100,15 @@ eigen_pair run_inverse_power(MPI_Comm comm, const vec<std::complex<double>>* sta
   x /= std::sqrt(nx2);
   krylov_options ko = opt.linear;
   ko.throw_on_failure = true;
+  const std::string context = ko.context;
+  int solve = 0;
   return aerohopf::internal::inverse_power_iteration(
       space, apply,
       [&](const vec<C>& v, long& linear_iterations) {
         vec<C> y = vec<C>::Zero(v.size());
+        // a failed solve names itself: which inverse power, its shift and which of its solves
+        ko.context = aerohopf::internal::concat(who, " at shift ", shift, ", shifted solve ", ++solve, " (BILU(",
+                                                opt.fill_level, ") block Jacobi; ", context, ")");
         linear_iterations += gmres(op, pc, v, y, ko).iterations;
         return y;
       },
@@ -157,6 +163,7 @@ eigen_pair inverse_power(distributed_euler<Dim>& d, const block_sparse_matrix<do
   a_norm = internal::max_over_ranks(comm, a_norm);
   block_ilu_options io;
   io.fill_level = opt.fill_level;
+  io.single_precision_factors = opt.single_precision_factors;
   io.context = "distributed inverse power: block-Jacobi BILU of P - sigma I";
   block_ilu<C, nv> ilu(io);
   internal::collective(comm, who, [&] { ilu.compute(shifted(owned_part(pre ? *pre : a), shift)); });

@@ -76,6 +76,7 @@ struct distributed_hopf_options {
   /// label, as for the serial solvers (normalisation and approximate_lhs do not apply).
   hopf_options hopf;
   int fill_level = 0;  ///< k of the block-Jacobi BILU(k)
+  bool single_precision_factors = true;  ///< as hopf_krylov_options
   /// GMRES of each correction: relative tolerance eta_k = min(eta_max, max(||F_k||, 0.1
   /// abs_tolerance / ||F_k||)) (inexact Newton, quadratic), restart and iteration limit.
   krylov_options krylov = newton_correction_krylov_options();
@@ -299,6 +300,7 @@ distributed_hopf_result solve_hopf(D& d, const distributed_hopf_point& guess,
   typename D::jacobian_rows a, l, ap, am;
   block_ilu_options io;
   io.fill_level = opt.fill_level;
+  io.single_precision_factors = opt.single_precision_factors;
   io.context = aerohopf::internal::concat(label, ": block-Jacobi BILU(", opt.fill_level, ") of L - i omega I");
   basic_distributed_bordered_preconditioner<dim, C> pc(io);
   block_ilu_options ior = io;
@@ -599,6 +601,7 @@ inline distributed_hopf_options hopf_options_from(const hopf_options& ho, const 
   distributed_hopf_options o;
   o.hopf = ho;
   o.fill_level = ko.fill_level;
+  o.single_precision_factors = ko.single_precision_factors;
   copy_gmres_shape(ko.krylov, o.krylov);
   o.eta_max = ko.eta_max;
   o.start_iterations = ko.start_iterations;
@@ -622,7 +625,9 @@ inline distributed_inverse_power_options inverse_power_options_from(const invers
 
 /// The distributed inverse-power options of a driver's Hopf start (hopf_start_krylov's).
 inline distributed_inverse_power_options inverse_power_options_from(const hopf_start_krylov_options& so) {
-  return inverse_power_options_from(so.inverse_power, so.fill_level, so.krylov);
+  distributed_inverse_power_options io = inverse_power_options_from(so.inverse_power, so.fill_level, so.krylov);
+  io.single_precision_factors = so.single_precision_factors;
+  return io;
 }
 
 /// The distributed inverse-power options of a V-g scan's (vg_krylov_options; the eigen-residual

@@ -12,7 +12,8 @@
 // lev_kj + 1); a block is kept iff lev_ij <= k. The pattern depends only on the block graph, so
 //   analyze(a)    symbolic phase: permutation, filter, levels -> factor pattern; once per pattern
 //   factorize(a)  numeric phase: copies a's (kept) blocks into the factor storage and
-//                 eliminates; no allocation; once per matrix
+//                 eliminates; no allocation (single-precision factors: the double working
+//                 copy is allocated here and released after the rounding); once per matrix
 //   apply(r, z)   z = (LU)^{-1} r by forward and backward block substitution
 // compute(a) does both (the symbolic phase only when the pattern changed).
 // A factorize() that throws (non-finite block, singular pivot, pattern other than the analysed
@@ -30,8 +31,11 @@
 // applied inside apply(), so callers always work in the original numbering.
 #include <Eigen/Dense>
 
+#include <algorithm>
 #include <cmath>
+#include <complex>
 #include <functional>
+#include <type_traits>
 #include <limits>
 #include <string>
 #include <vector>
@@ -92,6 +96,13 @@ struct block_ilu_options {
   bool reorder_rcm = false;           ///< reverse Cuthill-McKee on the filtered block graph
   coupling_filter filter;             ///< which couplings enter the preconditioner
   double pivot_rcond_tolerance = 1e-14;  ///< pivot block with smaller reciprocal condition: singular
+  /// Keep the factors in single precision (float, std::complex<float>): the elimination runs in
+  /// double, its result is rounded once, and apply() widens each value back to double, so the
+  /// sweeps stream half the bytes and the factors take half the memory. The preconditioner
+  /// changes by the rounding (relative 6e-8 per value), far below the incompleteness of BILU(k),
+  /// and the Krylov method still works with the exact operator in double, so its solutions do not
+  /// lose accuracy. Needs double or std::complex<double> and a compile-time block size.
+  bool single_precision_factors = false;
   std::string context = "BILU";       ///< prefix of error messages
 };
 
@@ -105,10 +116,14 @@ class block_ilu {
   using const_block_map = Eigen::Map<const block_type>;
   using segment_type = Eigen::Matrix<Scalar, B, 1>;
   using vector_type = vec<Scalar>;
+  /// Storage of single-precision factors (block_ilu_options::single_precision_factors).
+  using low_scalar = std::conditional_t<std::is_same_v<Scalar, std::complex<double>>, std::complex<float>, float>;
 
   block_ilu() = default;
   explicit block_ilu(block_ilu_options options) : opt_(std::move(options)) {
     require(opt_.fill_level >= 0, opt_.context, ": fill level ", opt_.fill_level, " < 0");
+    require(!opt_.single_precision_factors || internal::has_fast_block_kernel_v<Scalar, B>, opt_.context,
+            ": single-precision factors need double or std::complex<double> and a compile-time block size");
   }
   const block_ilu_options& options() const { return opt_; }
 
@@ -281,6 +296,11 @@ class block_ilu {
   index block_rows() const { return n_; }
   /// Non-zero blocks of the preconditioner (L + U + diagonal): its storage in blocks.
   index nonzero_blocks() const { return static_cast<index>(col_.size()); }
+  /// Bytes of the factors' values as apply() reads them (single_precision_factors: half).
+  std::size_t factor_bytes() const {
+    return std::size_t(col_.size()) * std::size_t(bs_ * bs_) *
+           (opt_.single_precision_factors ? sizeof(low_scalar) : sizeof(Scalar));
+  }
   /// perm[new] = old (empty without reordering).
   const std::vector<int>& permutation() const { return perm_; }
   /// Factor pattern in the (possibly permuted) numbering, for inspection.
@@ -292,6 +312,8 @@ class block_ilu {
     require(same_pattern(a), opt_.context, ": matrix pattern differs from the analysed one (", a.block_rows(),
             " block rows, ", a.nonzero_blocks(), " blocks vs ", n_, ", ", a_col_.size(), ")");
     const index bb = bs_ * bs_;
+    // every slot is written below (sourced ones copied, fill-in zeroed): no initialisation
+    if (val_.size() != col_.size() * std::size_t(bb)) val_.resize(col_.size() * std::size_t(bb));
     for (int sl : fill_slots_) std::fill_n(val_.data() + index(sl) * bb, bb, Scalar(0.0));
     const auto& av = a.values();
     for (int i = 0; i < n_; ++i)
@@ -330,6 +352,11 @@ class block_ilu {
         for (int q = row_ptr_[i]; q < row_ptr_[i + 1]; ++q) pos_[col_[q]] = -1;
         invert_pivot(i);
       }
+      if (opt_.single_precision_factors) {  // round once, then keep only the single copy
+        valf_.resize(val_.size());
+        std::transform(val_.begin(), val_.end(), valf_.begin(), [](const Scalar& x) { return low_scalar(x); });
+        std::vector<Scalar>().swap(val_);
+      }
       return;
     }
     for (int i = 0; i < n_; ++i) {
@@ -360,34 +387,8 @@ class block_ilu {
     else if (!fast)
       z = r;  // the fast forward sweep reads r itself (one vector pass less)
     if constexpr (fast) {
-      const Scalar* rin = perm_.empty() ? r.data() : w;
-      const Scalar* v = val_.data();
-      const int* rp = row_ptr_.data();
-      const int* dg = diag_.data();
-      const int* cl = col_.data();
-      const int* sl = slot_.data();
-      for (int i = 0; i < n_; ++i) {  // forward: L y = r (unit block diagonal)
-        Scalar acc[B];
-        Scalar* wi = w + index(i) * B;
-        const Scalar* ri = rin + index(i) * B;
-        for (int r = 0; r < B; ++r) acc[r] = ri[r];
-        const Scalar* lv = v + index(sl[rp[i]]) * B * B;  // L part of row i is contiguous
-        internal::prefetch_ahead(lv, index(dg[i] - rp[i]) * B * B * index(sizeof(Scalar)));
-        internal::block_row_gemv<-1, B>(lv, cl + rp[i], dg[i] - rp[i], w, acc);
-        for (int r = 0; r < B; ++r) wi[r] = acc[r];
-      }
-      for (int i = n_ - 1; i >= 0; --i) {  // backward: U x = y, diagonal stored inverted
-        Scalar acc[B];
-        Scalar* wi = w + index(i) * B;
-        for (int r = 0; r < B; ++r) acc[r] = wi[r];
-        const Scalar* uv = v + index(sl[dg[i]]) * B * B;  // diagonal, then the U part of row i
-        internal::prefetch_ahead(uv, index(rp[i + 1] - dg[i]) * B * B * index(sizeof(Scalar)));
-        internal::block_row_gemv<-1, B>(uv + B * B, cl + dg[i] + 1, rp[i + 1] - dg[i] - 1, w, acc);
-        Scalar out[B];
-        for (int r = 0; r < B; ++r) out[r] = Scalar(0.0);
-        internal::block_gemv<1, B>(uv, acc, out);
-        for (int r = 0; r < B; ++r) wi[r] = out[r];
-      }
+      if (opt_.single_precision_factors) sweeps(valf_.data(), perm_.empty() ? r.data() : w, w);
+      else sweeps(val_.data(), perm_.empty() ? r.data() : w, w);
     } else {
       segment_type acc(b);
       for (int i = 0; i < n_; ++i) {  // forward: L y = r (unit block diagonal)
@@ -406,6 +407,40 @@ class block_ilu {
     if (!perm_.empty())
       for (int i = 0; i < n_; ++i)
         z.template segment<B>(index(perm_[i]) * b, b) = Eigen::Map<const segment_type>(w + index(i) * b, b);
+  }
+
+  /// The two block sweeps of the fast kernels, the factors' values v stored in Scalar or in its
+  /// single precision: w = (LU)^{-1} rin (rin may be w itself).
+  template <class V>
+  void sweeps(const V* v, const Scalar* rin, Scalar* w) const {
+    {  // the factor pattern, read through plain pointers in the hot loops
+      const int* rp = row_ptr_.data();
+      const int* dg = diag_.data();
+      const int* cl = col_.data();
+      const int* sl = slot_.data();
+      for (int i = 0; i < n_; ++i) {  // forward: L y = r (unit block diagonal)
+        Scalar acc[B];
+        Scalar* wi = w + index(i) * B;
+        const Scalar* ri = rin + index(i) * B;
+        for (int r = 0; r < B; ++r) acc[r] = ri[r];
+        const V* lv = v + index(sl[rp[i]]) * B * B;  // L part of row i is contiguous
+        internal::prefetch_ahead(lv, index(dg[i] - rp[i]) * B * B * index(sizeof(V)));
+        internal::block_row_gemv<-1, B>(lv, cl + rp[i], dg[i] - rp[i], w, acc);
+        for (int r = 0; r < B; ++r) wi[r] = acc[r];
+      }
+      for (int i = n_ - 1; i >= 0; --i) {  // backward: U x = y, diagonal stored inverted
+        Scalar acc[B];
+        Scalar* wi = w + index(i) * B;
+        for (int r = 0; r < B; ++r) acc[r] = wi[r];
+        const V* uv = v + index(sl[dg[i]]) * B * B;  // diagonal, then the U part of row i
+        internal::prefetch_ahead(uv, index(rp[i + 1] - dg[i]) * B * B * index(sizeof(V)));
+        internal::block_row_gemv<-1, B>(uv + B * B, cl + dg[i] + 1, rp[i + 1] - dg[i] - 1, w, acc);
+        Scalar out[B];
+        for (int r = 0; r < B; ++r) out[r] = Scalar(0.0);
+        internal::block_gemv<1, B>(uv, acc, out);
+        for (int r = 0; r < B; ++r) wi[r] = out[r];
+      }
+    }
   }
 
   bool same_pattern(const matrix_type& a) const {
@@ -450,7 +485,8 @@ class block_ilu {
   std::vector<int> a_row_ptr_, a_col_;  // pattern of the analysed matrix
   std::vector<int> perm_, inv_;
   std::vector<int> row_ptr_, col_, diag_, source_, slot_, fill_slots_;
-  std::vector<Scalar> val_;
+  std::vector<Scalar> val_;      // the factors (single_precision_factors: only during factorize)
+  std::vector<low_scalar> valf_;  // the factors rounded to single precision (that option only)
   std::vector<int> pos_;
   mutable vector_type work_;
 };

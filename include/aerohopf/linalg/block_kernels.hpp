@@ -68,16 +68,41 @@ inline V in_register(V v) {
 }
 #endif
 
+/// The stored element type of a block whose products accumulate in S: S itself, or the single
+/// precision of S (float, std::complex<float>) for factors kept in half the bytes.
+template <class S>
+using single_precision_t = std::conditional_t<std::is_same_v<S, std::complex<double>>, std::complex<float>, float>;
+template <class S, class A>
+inline constexpr bool block_storage_v = std::is_same_v<A, S> || std::is_same_v<A, single_precision_t<S>>;
+
+// Loads of stored values into double registers: a float is widened exactly, so a kernel gives
+// the same sums on a block stored in float as on that block's values held in double.
+#if defined(__SSE2__)
+inline __m128d load2_pd(const double* p) { return _mm_loadu_pd(p); }
+inline __m128d load2_pd(const float* p) {  // two floats by a 64-bit integer load (may alias anything)
+  return _mm_cvtps_pd(_mm_castsi128_ps(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(p))));
+}
+#endif
+#if defined(AEROHOPF_AVX2_BLOCK_KERNELS)
+inline __m256d load4_pd(const double* p) { return _mm256_loadu_pd(p); }
+inline __m256d load4_pd(const float* p) { return _mm256_cvtps_pd(_mm_loadu_ps(p)); }
+inline __m128d load1_sd(const double* p) { return _mm_load_sd(p); }
+inline __m128d load1_sd(const float* p) { return _mm_set_sd(static_cast<double>(*p)); }
+#endif
+
 /// Partial sums of one block row: add(a, x) accumulates the B x B block a times the segment x;
-/// finish<Sign>(acc) does acc += Sign * sum. The primary template is the portable version.
+/// finish<Sign>(acc) does acc += Sign * sum. The block is stored in S or in its single
+/// precision (block_storage_v), the sums are always in S. The primary template is the portable
+/// version.
 template <class S, int B>
 struct row_accumulator {
   static_assert(std::is_same_v<S, double>, "row_accumulator: double and std::complex<double> only");
   double t[B] = {};
-  inline void add(const double* __restrict a, const double* __restrict x) {
+  template <class A>
+  inline void add(const A* __restrict a, const double* __restrict x) {
     for (int c = 0; c < B; ++c) {
       const double xc = x[c];
-      for (int r = 0; r < B; ++r) t[r] += a[c * B + r] * xc;
+      for (int r = 0; r < B; ++r) t[r] += static_cast<double>(a[c * B + r]) * xc;
     }
   }
   template <int Sign>
@@ -99,19 +124,20 @@ struct row_accumulator<std::complex<double>, B> {
   row_accumulator() {
     for (int v = 0; v < nv; ++v) p[v] = q[v] = _mm256_setzero_pd();
   }
-  inline void add(const std::complex<double>* __restrict ac, const std::complex<double>* __restrict xc) {
-    const double* a = reinterpret_cast<const double*>(ac);
+  template <class A>
+  inline void add(const A* __restrict ac, const std::complex<double>* __restrict xc) {
+    const auto* a = reinterpret_cast<const typename A::value_type*>(ac);  // (re, im) pairs
     const double* x = reinterpret_cast<const double*>(xc);
     for (int c = 0; c < B; ++c) {
       const __m256d xr = _mm256_broadcast_sd(x + 2 * c), xi = _mm256_broadcast_sd(x + 2 * c + 1);
-      const double* col = a + 2 * B * c;
+      const auto* col = a + 2 * B * c;
       for (int v = 0; v < nv; ++v) {
-        const __m256d av = in_register(_mm256_loadu_pd(col + 4 * v));
+        const __m256d av = in_register(load4_pd(col + 4 * v));
         p[v] = _mm256_fmadd_pd(av, xr, p[v]);
         q[v] = _mm256_fmadd_pd(av, xi, q[v]);
       }
       if constexpr (odd) {
-        const __m128d av = in_register(_mm_loadu_pd(col + 4 * nv));
+        const __m128d av = in_register(load2_pd(col + 4 * nv));
         p1 = _mm_fmadd_pd(av, _mm256_castpd256_pd128(xr), p1);
         q1 = _mm_fmadd_pd(av, _mm256_castpd256_pd128(xi), q1);
       }
@@ -135,14 +161,15 @@ struct row_accumulator<std::complex<double>, B> {
   row_accumulator() {
     for (int r = 0; r < B; ++r) t[r] = _mm_setzero_pd();
   }
-  inline void add(const std::complex<double>* __restrict ac, const std::complex<double>* __restrict xc) {
-    const double* a = reinterpret_cast<const double*>(ac);  // layout-compatible with double[2]
+  template <class A>
+  inline void add(const A* __restrict ac, const std::complex<double>* __restrict xc) {
+    const auto* a = reinterpret_cast<const typename A::value_type*>(ac);  // layout-compatible with T[2]
     const double* x = reinterpret_cast<const double*>(xc);
     for (int c = 0; c < B; ++c) {
       const __m128d xr = _mm_set1_pd(x[2 * c]);
       const __m128d xi = _mm_set_pd(x[2 * c + 1], -x[2 * c + 1]);
       for (int r = 0; r < B; ++r) {
-        const __m128d av = _mm_loadu_pd(a + 2 * (c * B + r));
+        const __m128d av = load2_pd(a + 2 * (c * B + r));
         const __m128d as = _mm_shuffle_pd(av, av, 1);
         t[r] = _mm_add_pd(t[r], _mm_add_pd(_mm_mul_pd(av, xr), _mm_mul_pd(as, xi)));
       }
@@ -158,8 +185,9 @@ struct row_accumulator<std::complex<double>, B> {
   }
 #else
   double re[B] = {}, im[B] = {};
-  inline void add(const std::complex<double>* __restrict ac, const std::complex<double>* __restrict xc) {
-    const double* a = reinterpret_cast<const double*>(ac);
+  template <class A>
+  inline void add(const A* __restrict ac, const std::complex<double>* __restrict xc) {
+    const auto* a = reinterpret_cast<const typename A::value_type*>(ac);
     const double* x = reinterpret_cast<const double*>(xc);
     for (int c = 0; c < B; ++c) {
       const double xr = x[2 * c], xi = x[2 * c + 1];
@@ -186,11 +214,12 @@ struct row_accumulator<std::complex<double>, B> {
 template <>
 struct row_accumulator<double, 4> {
   __m256d t0 = _mm256_setzero_pd(), t1 = _mm256_setzero_pd();
-  inline void add(const double* __restrict a, const double* __restrict x) {
-    t0 = _mm256_fmadd_pd(_mm256_loadu_pd(a), _mm256_broadcast_sd(x), t0);
-    t1 = _mm256_fmadd_pd(_mm256_loadu_pd(a + 4), _mm256_broadcast_sd(x + 1), t1);
-    t0 = _mm256_fmadd_pd(_mm256_loadu_pd(a + 8), _mm256_broadcast_sd(x + 2), t0);
-    t1 = _mm256_fmadd_pd(_mm256_loadu_pd(a + 12), _mm256_broadcast_sd(x + 3), t1);
+  template <class A>
+  inline void add(const A* __restrict a, const double* __restrict x) {
+    t0 = _mm256_fmadd_pd(load4_pd(a), _mm256_broadcast_sd(x), t0);
+    t1 = _mm256_fmadd_pd(load4_pd(a + 4), _mm256_broadcast_sd(x + 1), t1);
+    t0 = _mm256_fmadd_pd(load4_pd(a + 8), _mm256_broadcast_sd(x + 2), t0);
+    t1 = _mm256_fmadd_pd(load4_pd(a + 12), _mm256_broadcast_sd(x + 3), t1);
   }
   template <int Sign>
   inline void finish(double* __restrict acc) const {
@@ -204,19 +233,20 @@ template <>
 struct row_accumulator<double, 5> {
   __m256d t0 = _mm256_setzero_pd(), t1 = _mm256_setzero_pd();
   __m128d s0 = _mm_setzero_pd(), s1 = _mm_setzero_pd();
-  inline void add(const double* __restrict a, const double* __restrict x) {
+  template <class A>
+  inline void add(const A* __restrict a, const double* __restrict x) {
     const __m256d x0 = _mm256_broadcast_sd(x), x1 = _mm256_broadcast_sd(x + 1), x2 = _mm256_broadcast_sd(x + 2),
                   x3 = _mm256_broadcast_sd(x + 3), x4 = _mm256_broadcast_sd(x + 4);
-    t0 = _mm256_fmadd_pd(_mm256_loadu_pd(a), x0, t0);
-    t1 = _mm256_fmadd_pd(_mm256_loadu_pd(a + 5), x1, t1);
-    t0 = _mm256_fmadd_pd(_mm256_loadu_pd(a + 10), x2, t0);
-    t1 = _mm256_fmadd_pd(_mm256_loadu_pd(a + 15), x3, t1);
-    t0 = _mm256_fmadd_pd(_mm256_loadu_pd(a + 20), x4, t0);
-    s0 = _mm_fmadd_sd(_mm_load_sd(a + 4), _mm256_castpd256_pd128(x0), s0);
-    s1 = _mm_fmadd_sd(_mm_load_sd(a + 9), _mm256_castpd256_pd128(x1), s1);
-    s0 = _mm_fmadd_sd(_mm_load_sd(a + 14), _mm256_castpd256_pd128(x2), s0);
-    s1 = _mm_fmadd_sd(_mm_load_sd(a + 19), _mm256_castpd256_pd128(x3), s1);
-    s0 = _mm_fmadd_sd(_mm_load_sd(a + 24), _mm256_castpd256_pd128(x4), s0);
+    t0 = _mm256_fmadd_pd(load4_pd(a), x0, t0);
+    t1 = _mm256_fmadd_pd(load4_pd(a + 5), x1, t1);
+    t0 = _mm256_fmadd_pd(load4_pd(a + 10), x2, t0);
+    t1 = _mm256_fmadd_pd(load4_pd(a + 15), x3, t1);
+    t0 = _mm256_fmadd_pd(load4_pd(a + 20), x4, t0);
+    s0 = _mm_fmadd_sd(load1_sd(a + 4), _mm256_castpd256_pd128(x0), s0);
+    s1 = _mm_fmadd_sd(load1_sd(a + 9), _mm256_castpd256_pd128(x1), s1);
+    s0 = _mm_fmadd_sd(load1_sd(a + 14), _mm256_castpd256_pd128(x2), s0);
+    s1 = _mm_fmadd_sd(load1_sd(a + 19), _mm256_castpd256_pd128(x3), s1);
+    s0 = _mm_fmadd_sd(load1_sd(a + 24), _mm256_castpd256_pd128(x4), s0);
   }
   template <int Sign>
   inline void finish(double* __restrict acc) const {
@@ -323,18 +353,21 @@ inline void prefetch_ahead(const void* p, std::ptrdiff_t bytes, std::ptrdiff_t d
 #endif
 }
 
-/// acc += Sign * sum_{q < count} A_q x[cols[q]], the blocks A_q stored consecutively from a.
-template <int Sign, int B, class S>
-inline void block_row_gemv(const S* __restrict a, const int* __restrict cols, int count, const S* __restrict x,
+/// acc += Sign * sum_{q < count} A_q x[cols[q]], the blocks A_q stored consecutively from a (in
+/// S or in its single precision).
+template <int Sign, int B, class S, class A>
+  requires block_storage_v<S, A>
+inline void block_row_gemv(const A* __restrict a, const int* __restrict cols, int count, const S* __restrict x,
                            S* __restrict acc) {
   row_accumulator<S, B> t;
   for (int q = 0; q < count; ++q) t.add(a + static_cast<std::ptrdiff_t>(q) * B * B, x + static_cast<std::ptrdiff_t>(cols[q]) * B);
   t.template finish<Sign>(acc);
 }
 
-/// acc += Sign * A x for one B x B block.
-template <int Sign, int B, class S>
-inline void block_gemv(const S* __restrict a, const S* __restrict x, S* __restrict acc) {
+/// acc += Sign * A x for one B x B block (stored in S or in its single precision).
+template <int Sign, int B, class S, class A>
+  requires block_storage_v<S, A>
+inline void block_gemv(const A* __restrict a, const S* __restrict x, S* __restrict acc) {
   row_accumulator<S, B> t;
   t.add(a, x);
   t.template finish<Sign>(acc);
