@@ -135,8 +135,8 @@ double spmv_bytes(const M& a) {
 // sweep (on the out-of-cache matrices the vector is evicted by the factor stream in between).
 template <class S, int B>
 double ilu_apply_bytes(const block_ilu<S, B>& m) {
-  return double(m.factor_bytes()) + double(m.nonzero_blocks()) * sizeof(int) + double(m.block_rows()) * 2 * sizeof(int) +
-         4.0 * m.rows() * sizeof(S);
+  return double(m.factor_bytes()) + double(m.nonzero_blocks()) * sizeof(int) +
+         double(m.block_rows()) * 2 * sizeof(int) + 4.0 * m.rows() * sizeof(S);
 }
 
 std::string nm(std::initializer_list<std::string> parts) {

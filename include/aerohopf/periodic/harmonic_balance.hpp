@@ -448,7 +448,8 @@ class hill_operator {
   using C = std::complex<double>;
 
   void build(const S& sys, const Eigen::Ref<const Eigen::MatrixXd>& w, double mu, double omega, double sigma,
-             const Eigen::MatrixXd& d, int fill_level, hb_preconditioner_state state, const char* who) {
+             const Eigen::MatrixXd& d, int fill_level, bool single_precision_factors, hb_preconditioner_state state,
+             const char* who) {
     n_ = w.rows();
     nn_ = int(w.cols());
     h_ = (nn_ - 1) / 2;
@@ -488,15 +489,17 @@ class hill_operator {
       for (int j = 0; j < nn_; ++j) exact_.push_back(krylov_exact_jacobian<B>(sys, vec<double>(w.col(j)), mu, who));
       p.emplace(krylov_jacobians<B>(sys, vec<double>(w.rowwise().mean()), mu, who).preconditioning);
     }
-    if (int(ilu_.size()) != h_ + 1 || fill_level != fill_level_) {
+    if (int(ilu_.size()) != h_ + 1 || fill_level != fill_level_ || single_precision_factors != single_) {
       ilu_.clear();
       for (int k = 0; k <= h_; ++k) {
         block_ilu_options bo;
         bo.fill_level = fill_level;
+        bo.single_precision_factors = single_precision_factors;
         bo.context = concat(who, ": BILU(", fill_level, ") of P - (sigma + i ", k, " omega) I");
         ilu_.emplace_back(bo);
       }
       fill_level_ = fill_level;
+      single_ = single_precision_factors;
     }
     for (int k = 0; k <= h_; ++k) ilu_[std::size_t(k)].compute(*p, C(sigma, k * omega));
     // the real DFT pair: R fwd_ = [Re c_0 .. Re c_H, Im c_1 .. Im c_H] of c_k = (1/N) sum_j r_j
@@ -566,6 +569,7 @@ class hill_operator {
  private:
   Eigen::Index n_ = 0;
   int nn_ = 0, h_ = 0, fill_level_ = -1;
+  bool single_ = false;
   double omega_ = 0, sigma_ = 0;
   const Eigen::MatrixXd* d_ = nullptr;
   std::vector<bordered_block_matrix<double, B>> exact_;
@@ -588,6 +592,10 @@ class hill_operator {
 template <int B>
 struct hb_krylov {
   int fill_level = 1;                  ///< k of each BILU(k)
+  /// Each BILU's factors in single precision (block_ilu_options::single_precision_factors). Off:
+  /// it pays where the factors stream from memory (3D grids); on the coarse aerofoil's branch
+  /// (4,100 unknowns, H = 5) the same GMRES iterations and no time saved.
+  bool single_precision_factors = false;
   /// Relative tolerance of the GMRES solves outside Newton (the curve stepper's tangents), and of
   /// the Newton solves when adaptive_tolerance is false.
   double relative_tolerance = 1e-6;
@@ -626,7 +634,8 @@ struct hb_krylov {
       const Eigen::Index n = eq.n(), m = nn * n;
       const double omega = x[eq.omega_index()], mu = x[eq.mu_index()];
       const Eigen::Map<const Eigen::MatrixXd> w(x.data(), n, nn);
-      hill_.build(*sys_, w, mu, omega, 0.0, eq.differentiation(), o_.fill_level, o_.preconditioner, who_);
+      hill_.build(*sys_, w, mu, omega, 0.0, eq.differentiation(), o_.fill_level, o_.single_precision_factors,
+                  o_.preconditioner, who_);
       // the full operator [[Hill, U], [V, corner]]
       const Eigen::MatrixXd dw = w * eq.differentiation().transpose();
       Eigen::MatrixXd u = Eigen::MatrixXd::Zero(m, 3), v = Eigen::MatrixXd::Zero(3, m), corner = Eigen::MatrixXd::Zero(3, 3);
@@ -826,6 +835,7 @@ struct hill_krylov_options {
   int restarts = 4;           ///< explicit restarts from the unconverged Ritz vectors
   double tolerance = 1e-7;    ///< ||Hill x - lambda x|| <= tolerance max(1, |lambda|) ||x||
   int fill_level = 1;         ///< of the per-harmonic BILU(k)
+  bool single_precision_factors = false;  ///< as hb_krylov
   hb_preconditioner_state preconditioner = hb_preconditioner_state::mean_jacobian;
   double linear_tolerance = 1e-8;  ///< relative, of each GMRES solve
   int max_iterations = 1000, restart = 100;  ///< restart 50 stagnates at 1.05 Ubar* on the coarse aerofoil
@@ -861,7 +871,8 @@ floquet_result hill_floquet_krylov(const S& sys, const lco_solution& s, const hi
   const double sigma = std::isnan(o.shift) ? 0.01 * s.omega : o.shift;
   const Eigen::MatrixXd d = fourier_differentiation_matrix(nn);
   internal::hill_operator<B, S> hill;
-  hill.build(sys, s.instances, s.mu, s.omega, sigma, d, o.fill_level, o.preconditioner, who);
+  hill.build(sys, s.instances, s.mu, s.omega, sigma, d, o.fill_level, o.single_precision_factors, o.preconditioner,
+             who);
   auto op = [&](const vec<double>& x, vec<double>& y) { hill.apply(x, y); };
   auto pre = [&](const vec<double>& r, vec<double>& z) { hill.precondition(r, z); };
   krylov_options ko;
