@@ -33,9 +33,7 @@
 
 #include <algorithm>
 #include <cmath>
-#include <complex>
 #include <functional>
-#include <type_traits>
 #include <limits>
 #include <string>
 #include <vector>
@@ -117,7 +115,7 @@ class block_ilu {
   using segment_type = Eigen::Matrix<Scalar, B, 1>;
   using vector_type = vec<Scalar>;
   /// Storage of single-precision factors (block_ilu_options::single_precision_factors).
-  using low_scalar = std::conditional_t<std::is_same_v<Scalar, std::complex<double>>, std::complex<float>, float>;
+  using low_scalar = internal::single_precision_t<Scalar>;
 
   block_ilu() = default;
   explicit block_ilu(block_ilu_options options) : opt_(std::move(options)) {
