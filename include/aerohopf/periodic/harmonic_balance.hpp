@@ -594,7 +594,7 @@ struct hb_krylov {
   int fill_level = 1;                  ///< k of each BILU(k)
   /// Each BILU's factors in single precision (block_ilu_options::single_precision_factors). Off:
   /// it pays where the factors stream from memory (3D grids); on the coarse aerofoil's branch
-  /// (4,100 unknowns, H = 5) the same GMRES iterations and no time saved.
+  /// (4,100 unknowns, H = 5) the GMRES iterations within one and no time saved.
   bool single_precision_factors = false;
   /// Relative tolerance of the GMRES solves outside Newton (the curve stepper's tangents), and of
   /// the Newton solves when adaptive_tolerance is false.
