@@ -199,7 +199,18 @@ std::vector<boundary_run> boundaries(const flutter_options& o, const std::filesy
   const models::flutter_reference ref = agard_reference(wing.planform);
   std::vector<int> strides = o.strides;
   if (o.vg_stride) strides.push_back(o.vg_stride);
-  for (double zeta : o.damping_percent) {
+  // the finer levels' dampings first, in their listed order: on a finer level the first of them
+  // starts from the coarser boundary (grid sequencing), each later one from the same level's
+  // boundary at the nearest damping done (continuation in damping; the medium grid's boundary
+  // without damping started from the coarse one converges to the trivial Hopf point mu = 0)
+  std::vector<double> order;
+  for (double z : o.fine_damping_percent)
+    if (std::find(o.damping_percent.begin(), o.damping_percent.end(), z) != o.damping_percent.end() &&
+        std::find(order.begin(), order.end(), z) == order.end())
+      order.push_back(z);
+  for (double z : o.damping_percent)
+    if (std::find(order.begin(), order.end(), z) == order.end()) order.push_back(z);
+  for (double zeta : order) {
     models::wing_family serial(wing, grid, strides, modes, Eigen::VectorXd::Constant(1, zeta / 100),
                                tunnel_schedule());
     if (o.verbose) serial.steady_options().log = log;  // a line per steady step (rank 0 only on the ranks)
@@ -221,6 +232,15 @@ std::vector<boundary_run> boundaries(const flutter_options& o, const std::filesy
       fo.verbose = o.verbose && log;
       fo.log = log;
       fo.label = name + " " + damping_tag(zeta);
+      const boundary_run* neighbour = nullptr;  // this level's boundary at the nearest damping done
+      for (const boundary_run& q : runs)
+        if (finer && q.stride == s && !q.b.points.empty() && std::abs(q.b.points.front().mach - o.machs.front()) < 1e-9 &&
+            (!neighbour || std::abs(q.damping - zeta) < std::abs(neighbour->damping - zeta)))
+          neighbour = &q;
+      if (neighbour) {  // Newton from its point (flutter_boundary_options::start_point)
+        fo.start_point = neighbour->b.points.front().point;
+        output([&] { std::printf("  first point from the %g %% boundary's on this grid\n", neighbour->damping); });
+      }
       const auto t0 = std::chrono::steady_clock::now();
       boundary_run r{s, zeta, trace_flutter_boundary(family, s, o.machs, coarser, fo), 0};
       r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

@@ -201,6 +201,47 @@ TEST(FlutterBoundary, CoarsePredictorChangesStartsNotPoints) {
   EXPECT_EQ(n, machs.size());
 }
 
+// Continuation in a structural parameter: the mass ratio 12 boundary's first coarse point by
+// Newton from the mass ratio 10 coarse point (start_point, although a coarser boundary is given)
+// is the point grid sequencing gives, the coarser boundary still serves the next Mach number, and
+// a start point of another level's size or with a bad frequency is refused.
+TEST(FlutterBoundary, StartPointContinuesInAStructuralParameter) {
+  const auto f10 = family(10.0), f12 = family(12.0);
+  const flutter_boundary a = trace_flutter_boundary(f10, 4, {0.5}, nullptr, options_for(f10, 1.66, 0.75, "mu_s 10"));
+  ASSERT_EQ(a.points.size(), 1u);
+  const flutter_boundary_options o12 = options_for(f12, 1.66, 0.75, "mu_s 12");
+  const flutter_boundary vc = trace_flutter_boundary(f12, 8, {0.5, 0.55}, nullptr, o12);
+  ASSERT_TRUE(vc.complete) << vc.stop_reason;
+  const flutter_boundary ref = trace_flutter_boundary(f12, 4, {0.5, 0.55}, &vc, o12);
+  ASSERT_TRUE(ref.complete) << ref.stop_reason;
+  EXPECT_GT(ref.points[0].mu / a.points[0].mu, 1.05);  // a different problem, not the same point again
+
+  flutter_boundary_options o = o12;
+  o.label = "mu_s 12 from 10";
+  o.start_point = a.points[0].point;
+  std::ostringstream log;
+  o.log = &log;
+  o.verbose = true;
+  const flutter_boundary b = trace_flutter_boundary(f12, 4, {0.5, 0.55}, &vc, o);
+  ASSERT_TRUE(b.complete) << b.stop_reason;
+  ASSERT_EQ(b.points.size(), ref.points.size());
+  for (std::size_t k = 0; k < b.points.size(); ++k) {
+    EXPECT_NEAR(b.points[k].mu / ref.points[k].mu, 1.0, 1e-6) << k;
+    EXPECT_NEAR(b.points[k].omega / ref.points[k].omega, 1.0, 1e-6) << k;
+  }
+  ASSERT_FALSE(b.attempts.empty());
+  EXPECT_EQ(b.attempts.front().kind, "start point");
+  EXPECT_EQ(log.str().find("inverse power"), std::string::npos) << log.str();
+  EXPECT_NE(log.str().find("predictor ||F||"), std::string::npos) << log.str();  // the coarser boundary at M = 0.55
+
+  o.log = nullptr;
+  EXPECT_TRUE(test::contains(test::input_error_of([&] { trace_flutter_boundary(f12, 8, {0.5}, nullptr, o); }),
+                             "start_point.p has size"));
+  o.start_point->omega = NAN;
+  EXPECT_TRUE(test::contains(test::input_error_of([&] { trace_flutter_boundary(f12, 4, {0.5}, nullptr, o); }),
+                             "start_point.omega"));
+}
+
 TEST(FlutterBoundary, CostsArePureFunctionsOfThePoints) {
   flutter_boundary b;
   auto pt = [](double m, double hopf, double st, bool own) {

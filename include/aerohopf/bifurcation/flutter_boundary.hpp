@@ -53,6 +53,7 @@
 #include <cstdio>
 #include <deque>
 #include <iostream>
+#include <limits>
 #include <map>
 #include <optional>
 #include <string>
@@ -113,6 +114,18 @@ enum class coarse_predictor { off, values, full, automatic };
 struct flutter_boundary_options {
   /// Start of the first point (inverse power with shift i start_omega at start_mu).
   double start_mu = 1, start_omega = 1;
+  /// Or the first point by Newton from a Hopf point of a neighbouring problem on the same level
+  /// (instead of the coarser boundary's point and the inverse power; a coarser boundary still
+  /// serves the later points): continuation in a structural parameter, e.g. from this level's
+  /// flutter point at another structural damping, where grid sequencing converges to another Hopf
+  /// point (AGARD 445.6 medium, no damping: the trivial one at mu = 0). p must have the level's
+  /// size; w is not used. ||F|| there holds only the changed parameter's term and is small while
+  /// the correction is not, so the first step is not judged by divergence_factor, and its GMRES
+  /// restarts at start_point_restart at the least, with the second Gram-Schmidt pass where needed:
+  /// GMRES(80) stalls on that correction (AGARD coarse, 0.5 % -> none: relative residual 0.98
+  /// after 400 iterations; unrestarted, 166).
+  std::optional<hopf_point> start_point;
+  int start_point_restart = 300;
   /// Newton criterion ||F|| <= tolerance of the boundary points. 1e-7: Ubar* then changes by
   /// < 1e-9 relative in a further iteration on the light medium NACA 0012 boundary, far below the
   /// grid error; it fixes Ubar* only to ~2e-5 on the heavy one (mu enters only the stiffness).
@@ -240,7 +253,7 @@ struct flutter_boundary_point {
 /// One attempt of natural continuation (accepted or not) or an arclength stretch.
 struct flutter_attempt {
   double mach = 0;
-  std::string kind;     ///< "continued", "coarse restart", "first", "arclength", "coarser-level bridge", "bridge restart"
+  std::string kind;     ///< "continued", "coarse restart", "first", "start point", "arclength", "coarser-level bridge", "bridge restart"
   std::string outcome;  ///< "accepted", "other mode", "failed: ..."
   double seconds = 0;
 };
@@ -325,6 +338,15 @@ inline void check_flutter_boundary_options(const flutter_boundary_options& o, co
           o.start_mu, ")");
   require(std::isfinite(o.start_omega) && o.start_omega > 0, where, ": start_omega must be finite and > 0 (got ",
           o.start_omega, ")");
+  if (o.start_point) {
+    require(std::isfinite(o.start_point->mu) && o.start_point->mu != 0, where,
+            ": start_point.mu must be finite and non-zero (got ", o.start_point->mu, ")");
+    require(std::isfinite(o.start_point->omega) && o.start_point->omega > 0, where,
+            ": start_point.omega must be finite and > 0 (got ", o.start_point->omega, ")");
+    require(o.start_point->p.size() > 0 && o.start_point->p.allFinite() && o.start_point->p.norm() > 0, where,
+            ": start_point.p must be a finite non-zero vector (size ", o.start_point->p.size(), ")");
+    require(o.start_point_restart >= 1, where, ": start_point_restart must be >= 1 (got ", o.start_point_restart, ")");
+  }
   require(o.tolerance > 0 && std::isfinite(o.tolerance), where, ": tolerance must be > 0 (got ", o.tolerance, ")");
   require(!std::isnan(o.mu_min) && o.mu_min < INFINITY, where, ": mu_min must be a number below infinity (got ",
           o.mu_min, ")");
@@ -630,6 +652,11 @@ class flutter_boundary_tracer {
       ko.start_iterations = 0;
     }
     hopf_options ho = hopf_opts(label, !o_.moving_equilibrium);
+    if (std::string(kind) == "start point") {  // flutter_boundary_options::start_point
+      ho.newton.divergence_factor = std::numeric_limits<double>::infinity();
+      ko.krylov.restart = std::max(ko.krylov.restart, o_.start_point_restart);
+      ko.krylov.reorthogonalize = true;  // a long basis: one Gram-Schmidt pass loses orthogonality
+    }
     const auto t0 = clk::now();
     try {
       hopf_result h = o_.moving_equilibrium ? full_hopf(s, g, st.mu, ho, ko, label)
@@ -1225,6 +1252,13 @@ flutter_boundary flutter_boundary_tracer<F>::run() {
         // the coarse-grid restart below is this attempt
       } else if (!pts_.empty()) {
         guess = predict(s, m, st, label);
+      } else if (o_.start_point) {  // continuation in a structural parameter on this level
+        require(o_.start_point->p.size() == s.size(), o_.label, ": start_point.p has size ", o_.start_point->p.size(),
+                " but the level's system has ", s.size(), " unknowns");
+        guess = *o_.start_point;
+        flutter_say(log_, "    %s: Newton from the given point (mu = %.6g, omega = %.6g)\n", label.c_str(), guess.mu,
+                    guess.omega);
+        kind = "start point";
       } else if (coarser_) {  // grid sequencing from the coarser boundary at this Mach number
         auto cg = coarse_guess(s, m);
         require(cg.has_value(), o_.label, ": no coarse-grid point at M = ", m, " to start this level from");

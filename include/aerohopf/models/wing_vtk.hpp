@@ -63,7 +63,8 @@ inline flutter_mode_frames flutter_mode_states(const wing_system& s, const hopf_
           ": the eigenvector does not move the wing (largest displacement ", f.peak_displacement, ")");
   require(!s.flow().first_nonphysical_cell(h.w.data()), who, ": the Hopf point's equilibrium is not a physical state");
   f.eps = displacement / f.peak_displacement;
-  for (int halvings = 0;; ++halvings) {
+  int halvings = 0;
+  for (;; ++halvings) {
     f.states.clear();
     bool physical = true;
     for (int k = 0; k < phases && physical; ++k) {
@@ -75,7 +76,8 @@ inline flutter_mode_frames flutter_mode_states(const wing_system& s, const hopf_
     require(halvings < 60, who, ": no scale of the eigenvector keeps the flow physical");
     f.eps *= 0.5;
   }
-  f.displacement = f.eps * f.peak_displacement;
+  // exactly the one asked for unless halved (eps * peak can round below it)
+  f.displacement = halvings == 0 ? displacement : f.eps * f.peak_displacement;
   return f;
 }
 
