@@ -202,7 +202,8 @@ std::vector<boundary_run> boundaries(const flutter_options& o, const std::filesy
   // the finer levels' dampings first, in their listed order: on a finer level the first of them
   // starts from the coarser boundary (grid sequencing), each later one from the same level's
   // boundary at the nearest damping done (continuation in damping; the medium grid's boundary
-  // without damping started from the coarse one converges to the trivial Hopf point mu = 0)
+  // without damping started from the coarse one converges to the trivial Hopf point mu = 0),
+  // and where that fails, by grid sequencing
   std::vector<double> order;
   for (double z : o.fine_damping_percent)
     if (std::find(o.damping_percent.begin(), o.damping_percent.end(), z) != o.damping_percent.end() &&
@@ -242,7 +243,15 @@ std::vector<boundary_run> boundaries(const flutter_options& o, const std::filesy
         output([&] { std::printf("  first point from the %g %% boundary's on this grid\n", neighbour->damping); });
       }
       const auto t0 = std::chrono::steady_clock::now();
-      boundary_run r{s, zeta, trace_flutter_boundary(family, s, o.machs, coarser, fo), 0};
+      boundary_run r{s, zeta, {}, 0};
+      try {
+        r.b = trace_flutter_boundary(family, s, o.machs, coarser, fo);
+      } catch (const convergence_error& e) {  // thrown alike on every rank (the same decisions everywhere)
+        if (!fo.start_point || !coarser) throw;
+        output([&] { std::printf("  %s\n  grid sequencing from the coarser boundary instead\n", e.what()); });
+        fo.start_point.reset();
+        r.b = trace_flutter_boundary(family, s, o.machs, coarser, fo);
+      }
       r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
       output([&] {
         csv_writer csv(out / ("boundary_" + name + "_" + damping_tag(zeta) + ".csv"),
