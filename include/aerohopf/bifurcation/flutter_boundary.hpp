@@ -642,7 +642,8 @@ class flutter_boundary_tracer {
   }
 
   std::optional<flutter_boundary_point> hopf_at(const S& s, double mach, const solved_flow& st, const hopf_point& guess,
-                                                const std::string& label, const char* kind) {
+                                                const std::string& label, const char* kind,
+                                                bool from_start_point = false) {
     hopf_point g = guess;
     g.w = st.w;
     hopf_krylov_options ko = o_.krylov;
@@ -652,7 +653,7 @@ class flutter_boundary_tracer {
       ko.start_iterations = 0;
     }
     hopf_options ho = hopf_opts(label, !o_.moving_equilibrium);
-    if (std::string(kind) == "start point") {  // flutter_boundary_options::start_point
+    if (from_start_point) {  // flutter_boundary_options::start_point
       ho.newton.divergence_factor = std::numeric_limits<double>::infinity();
       ko.krylov.restart = std::max(ko.krylov.restart, o_.start_point_restart);
       ko.krylov.reorthogonalize = true;  // a long basis: one Gram-Schmidt pass loses orthogonality
@@ -1248,6 +1249,7 @@ flutter_boundary flutter_boundary_tracer<F>::run() {
         }
       }
       const char* kind = "continued";
+      bool from_start_point = false;
       if (preempted) {
         // the coarse-grid restart below is this attempt
       } else if (!pts_.empty()) {
@@ -1259,6 +1261,7 @@ flutter_boundary flutter_boundary_tracer<F>::run() {
         flutter_say(log_, "    %s: Newton from the given point (mu = %.6g, omega = %.6g)\n", label.c_str(), guess.mu,
                     guess.omega);
         kind = "start point";
+        from_start_point = true;
       } else if (coarser_) {  // grid sequencing from the coarser boundary at this Mach number
         auto cg = coarse_guess(s, m);
         require(cg.has_value(), o_.label, ": no coarse-grid point at M = ", m, " to start this level from");
@@ -1275,7 +1278,7 @@ flutter_boundary flutter_boundary_tracer<F>::run() {
         kind = "first";
       }
       const double start_seconds = flutter_seconds_since(t0);
-      auto p = preempted ? std::nullopt : hopf_at(s, m, st, guess, label, kind);
+      auto p = preempted ? std::nullopt : hopf_at(s, m, st, guess, label, kind, from_start_point);
       auto t_attempt = t0;  // start of the attempt whose time a failure charges to rejected_
       if (p) p->hopf_seconds += start_seconds;
       const bool restarted = !p && o_.coarse_restart && coarser_ && !pts_.empty() && flutter_listed(machs, m);
