@@ -3,7 +3,8 @@
 // SparseLU solution; GCR and GMRES (both minimal-residual) produce the same first-cycle residual
 // history; restart behaviour; complex vs real 2n formulations give the same solution; operator
 // kinds (matrix-free lambda, bordered); the compute/solve wrapper against direct_solver;
-// failure reporting (iteration limit, NaN, sizes).
+// failure reporting (iteration limit, NaN, sizes); deflated restarts (GMRES-DR) against plain
+// restarts and the direct solution.
 #include <gtest/gtest.h>
 
 #include <aerohopf/linalg.hpp>
@@ -257,6 +258,104 @@ TEST(Krylov, ReorthogonalizationThresholdOutOfRangeIsRefused) {
     ob.reorthogonalization_threshold = bad;
     vec<cd> x;
     EXPECT_THROW(gmres(a, identity_preconditioner{}, b, x, ob), input_error) << bad;
+  }
+}
+
+// GMRES-DR(m, k) (krylov_options::deflation) against plain GMRES(m) and the direct solution on
+// three spectra that make short restarts stall: real eigenvalues spread over [1, 1000] (Morgan's
+// bidiagonal matrix, SIAM J. Sci. Comput. 24, 2002, example 1), a real matrix whose smallest
+// eigenvalues are complex pairs (the real span of a split pair is kept), and an unpreconditioned
+// complex convection-diffusion operator.
+template <class S>
+void expect_deflation_helps(const Eigen::SparseMatrix<S>& a, int m, int k, double max_ratio, const char* what) {
+  const vec<S> b = vec<S>::Ones(a.rows()) + S(0.5) * vec<S>::Random(a.rows());
+  const vec<S> x_ref = sparse_lu_solve<S>(a, b);
+  krylov_options o;
+  o.relative_tolerance = 1e-10;
+  o.restart = m;
+  o.max_iterations = 3000;  // plain restarts may stall (counted as 3000)
+  vec<S> x_plain, x_dr;
+  const auto plain = gmres(a, identity_preconditioner{}, b, x_plain, o);
+  o.deflation = k;
+  const auto dr = gmres(a, identity_preconditioner{}, b, x_dr, o);
+  std::cout << what << ": GMRES(" << m << ") " << plain.iterations << " iterations, GMRES-DR(" << m << "," << k << ") "
+            << dr.iterations << "\n";
+  EXPECT_EQ(dr.method, "GMRES-DR");
+  ASSERT_TRUE(dr.converged) << what << ": " << dr.reason;
+  EXPECT_LE(dr.relative_residual, 1e-10);
+  EXPECT_NEAR((a * x_dr - b).norm() / b.norm(), dr.relative_residual, 1e-13) << what;  // reported = true
+  EXPECT_LT((x_dr - x_ref).norm(), 1e-7 * x_ref.norm()) << what;
+  EXPECT_LT(dr.iterations, max_ratio * plain.iterations) << what;
+}
+
+TEST(Krylov, DeflatedRestartsKeepTheSmallEigenvaluesAndGiveTheDirectSolution) {
+  {  // Morgan's bidiagonal matrix: diagonal 1 .. 1000, superdiagonal 0.1
+    const int n = 1000;
+    Eigen::SparseMatrix<double> a(n, n);
+    for (int i = 0; i < n; ++i) {
+      a.insert(i, i) = 1.0 + i;
+      if (i + 1 < n) a.insert(i, i + 1) = 0.1;
+    }
+    expect_deflation_helps<double>(a, 20, 5, 0.5, "bidiagonal 1..1000");
+  }
+  {  // 2 x 2 rotation blocks a +- i b, a in [1, 50], and three small pairs near the origin
+    const int pairs = 300;
+    Eigen::SparseMatrix<double> a(2 * pairs, 2 * pairs);
+    for (int p = 0; p < pairs; ++p) {
+      double re = 1.0 + 49.0 * p / (pairs - 1), im = 0.5 * re;
+      if (p < 3) {
+        re = 0.01 * (p + 1);
+        im = 0.03 * (p + 1);
+      }
+      a.insert(2 * p, 2 * p) = re;
+      a.insert(2 * p, 2 * p + 1) = im;
+      a.insert(2 * p + 1, 2 * p) = -im;
+      a.insert(2 * p + 1, 2 * p + 1) = re;
+    }
+    expect_deflation_helps<double>(a, 15, 6, 0.5, "real, complex pairs near the origin");
+  }
+  {  // complex unpreconditioned convection-diffusion, 40 x 40 cells
+    const auto a = shifted(convection_diffusion<double, 4>(40, 40, 4, 0.5, 0.5, 7), cd(0, 0.05));
+    expect_deflation_helps<cd>(a.to_sparse(), 30, 10, 0.8, "complex convection-diffusion");
+  }
+}
+
+TEST(Krylov, DeflatedGmresOnADistributedOperatorGivesTheLocalIterates) {
+  const auto a = convection_diffusion<double, 4>(20, 20, 4, 0.5, 0.5, 3);
+  struct one_process {
+    const block_sparse_matrix<double, 4>* a;
+    mutable int sums = 0;
+    Eigen::Index rows() const { return a->rows(); }
+    void apply(const vec<double>& x, vec<double>& y) const { a->multiply(x, y); }
+    void global_sum(double*, int) const { ++sums; }
+  };
+  const one_process d{&a};
+  const vec<double> b = vec<double>::Random(a.rows());
+  krylov_options o;
+  o.relative_tolerance = 1e-10;
+  o.restart = 20;
+  o.deflation = 6;
+  o.max_iterations = 5000;
+  vec<double> x_local, x_dist;
+  const auto local = gmres(a, identity_preconditioner{}, b, x_local, o);
+  const auto dist = gmres(d, identity_preconditioner{}, b, x_dist, o);
+  ASSERT_TRUE(local.converged && dist.converged) << local.reason;
+  EXPECT_GT(local.iterations, o.restart);  // deflated restarts happened
+  EXPECT_EQ(x_local, x_dist);
+  EXPECT_EQ(local.residual_history, dist.residual_history);
+}
+
+TEST(Krylov, DeflationOutOfRangeIsRefused) {
+  const auto a = convection_diffusion<double, 4>(6, 6, 4, 0.5, 0.5, 7);
+  const vec<double> b = vec<double>::Random(a.rows());
+  for (const int bad : {-1, 19, 25}) {
+    krylov_options o;
+    o.restart = 20;
+    o.deflation = bad;
+    vec<double> x;
+    const std::string msg = input_error_of([&] { gmres(a, identity_preconditioner{}, b, x, o); });
+    EXPECT_TRUE(contains(msg, "deflation")) << msg;
+    EXPECT_EQ(x.size(), 0);  // untouched
   }
 }
 

@@ -30,10 +30,12 @@
 // Iteration counts: GCR/GMRES count one step per operator product; TFQMR and BiCGSTAB count
 // one iteration per TWO operator products (operator_applications gives the comparable cost).
 #include <Eigen/Core>
+#include <Eigen/Eigenvalues>
+#include <Eigen/LU>
 
+#include <algorithm>
 #include <cmath>
 #include <complex>
-#include <algorithm>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -63,6 +65,12 @@ struct krylov_options {
   /// its norm is orthogonal to the basis to rounding after one pass; PETSc's CGS refinement "if
   /// needed"). 1 gives the second pass always.
   double reorthogonalization_threshold = 0.70710678118654752;
+  /// GMRES only: k of GMRES-DR(m, k) (Morgan, SIAM J. Sci. Comput. 24, 2002). At each restart
+  /// the k harmonic Ritz vectors of A M^{-1} of smallest harmonic Ritz value (for a real A, the
+  /// real span of the selected pairs: k + 1 where a pair is split) and the residual are kept, so
+  /// the eigenvalues nearest the origin that a restart would forget stay deflated; 0 = plain
+  /// restarted GMRES(m). Memory n (m + k + 3) scalars instead of n (m + 1). Needs k + 2 <= m.
+  int deflation = 0;
 };
 
 /// The GMRES options of inexact Newton corrections (the steady, equilibrium and Hopf Newton
@@ -101,6 +109,8 @@ inline void validate_krylov_options(const krylov_options& opt, std::string_view 
   require(opt.max_iterations >= 0, where, ": max_iterations ", opt.max_iterations, " must be >= 0");
   require(opt.reorthogonalization_threshold >= 0 && opt.reorthogonalization_threshold <= 1, where,
           ": reorthogonalization_threshold ", opt.reorthogonalization_threshold, " must be in [0, 1]");
+  require(opt.deflation >= 0 && (opt.deflation == 0 || opt.deflation + 2 <= opt.restart), where, ": deflation ",
+          opt.deflation, " must be 0 or in [1, restart - 2] (restart ", opt.restart, ")");
 }
 
 namespace internal {
@@ -218,11 +228,274 @@ struct krylov_state {
 
 }  // namespace internal
 
+namespace internal {
+
+/// Plane rotation [c s; -conj(s) c] with c real: zeroes b under a, a <- (a/|a|) sqrt(|a|^2+|b|^2).
+template <class S>
+struct krylov_rotation {
+  Eigen::Index row = 0;  // acts on rows (row, row + 1)
+  real_of_t<S> c{};
+  S s{};
+  template <class V>
+  void apply(V&& v) const {
+    const S t = c * v(row) + s * v(row + 1);
+    v(row + 1) = -Eigen::numext::conj(s) * v(row) + c * v(row + 1);
+    v(row) = t;
+  }
+  /// The rotation zeroing v(row + 1) against v(row), applied to v; false if both are zero.
+  static bool make(Eigen::Index row, S& a, S& b, krylov_rotation& out) {
+    using real = real_of_t<S>;
+    using std::abs;
+    using std::sqrt;
+    const real aa = abs(a), ab = abs(b), nu = sqrt(aa * aa + ab * ab);
+    out.row = row;
+    if (nu == real(0)) return false;
+    if (aa == real(0)) {
+      out.c = real(0);
+      out.s = Eigen::numext::conj(b) / S(ab);
+      a = S(ab);
+    } else {
+      out.c = aa / nu;
+      out.s = (a / S(aa)) * Eigen::numext::conj(b) / S(nu);
+      a = (a / S(aa)) * S(nu);
+    }
+    b = S(0.0);
+    return true;
+  }
+};
+
+template <class S>
+std::complex<double> to_complex_double(const S& v) {
+  return {static_cast<double>(Eigen::numext::real(v)), static_cast<double>(Eigen::numext::imag(v))};
+}
+
+/// The orthonormal basis (columns of q, m x kept) of the real (real S) or complex span of the
+/// harmonic Ritz vectors of the k smallest harmonic Ritz values of the Arnoldi relation
+/// A M^{-1} V_m = V_{m+1} hbar, i.e. the eigenvectors of H_m + |h_{m+1,m}|^2 H_m^{-H} e_m e_m^T.
+/// The small eigenproblem is solved in complex double (it only chooses the subspace; the
+/// projected matrices are formed in S). Returns 0 where H_m is singular or nothing is found.
+template <class S>
+int harmonic_ritz_basis(const Eigen::Matrix<S, Eigen::Dynamic, Eigen::Dynamic>& hbar, int m, int k, int kmax,
+                        Eigen::Matrix<S, Eigen::Dynamic, Eigen::Dynamic>& q) {
+  using cd = std::complex<double>;
+  using cmat = Eigen::Matrix<cd, Eigen::Dynamic, Eigen::Dynamic>;
+  using real = real_of_t<S>;
+  cmat hm(m, m);
+  for (int j = 0; j < m; ++j)
+    for (int i = 0; i < m; ++i) hm(i, j) = to_complex_double(hbar(i, j));
+  const double hlast = std::abs(to_complex_double(hbar(m, m - 1)));
+  const Eigen::PartialPivLU<cmat> lu(hm.adjoint());
+  if (!(std::abs(lu.determinant()) > 0.0) || !(lu.rcond() > 1e-14)) return 0;
+  Eigen::VectorXcd em = Eigen::VectorXcd::Zero(m);
+  em(m - 1) = 1.0;
+  const Eigen::VectorXcd f = lu.solve(em);
+  cmat g = hm;
+  g.col(m - 1) += (hlast * hlast) * f;
+  if (!g.allFinite()) return 0;
+  const Eigen::ComplexEigenSolver<cmat> es(g);
+  if (es.info() != Eigen::Success) return 0;
+  std::vector<int> order(static_cast<std::size_t>(m));
+  for (int i = 0; i < m; ++i) order[static_cast<std::size_t>(i)] = i;
+  std::stable_sort(order.begin(), order.end(),
+                   [&](int a, int b) { return std::abs(es.eigenvalues()(a)) < std::abs(es.eigenvalues()(b)); });
+  // candidates: the selected eigenvectors, or for a real S their real and imaginary parts
+  Eigen::Matrix<S, Eigen::Dynamic, Eigen::Dynamic> cand(m, 2 * k);
+  int nc = 0;
+  for (int t = 0; t < k; ++t) {
+    const Eigen::VectorXcd e = es.eigenvectors().col(order[static_cast<std::size_t>(t)]);
+    if constexpr (is_complex_v<S>) {
+      for (int i = 0; i < m; ++i) cand(i, nc) = S(real(e(i).real()), real(e(i).imag()));
+      ++nc;
+    } else {
+      for (int i = 0; i < m; ++i) cand(i, nc) = S(e(i).real());
+      ++nc;
+      if (e.imag().norm() > 1e-12 * e.norm()) {
+        for (int i = 0; i < m; ++i) cand(i, nc) = S(e(i).imag());
+        ++nc;
+      }
+    }
+  }
+  // orthonormalise (Gram-Schmidt twice), dropping dependent candidates (a pair's partner adds
+  // nothing to the real span), at most kmax vectors
+  q.resize(m, kmax);
+  int kept = 0;
+  for (int t = 0; t < nc && kept < kmax; ++t) {
+    auto v = cand.col(t);
+    const real before = v.norm();
+    if (!(before > real(0))) continue;
+    for (int pass = 0; pass < 2; ++pass) v -= q.leftCols(kept) * (q.leftCols(kept).adjoint() * v);
+    const real after = v.norm();
+    if (!(after > real(1e-8) * before)) continue;
+    q.col(kept++) = v / S(after);
+  }
+  return kept;
+}
+
+/// GMRES-DR(m, k) (krylov_options::deflation): GMRES(m) whose restarts keep the harmonic Ritz
+/// vectors of the k smallest harmonic Ritz values. Cycle: the basis V_{kk+1} carried over (kk = 0
+/// at the start and after a plain restart) with A M^{-1} V_kk = V_{kk+1} H_kk (dense (kk+1) x kk),
+/// extended by Arnoldi to m columns; the least squares problem by Givens rotations (the dense
+/// leading block first, then one rotation per step); x += M^{-1} V y; then with P_k the
+/// orthonormal harmonic Ritz basis and P_{k+1} = [P_k; 0] plus the residual coordinates
+/// c - hbar y, the new V_{k+1} = V_{m+1} P_{k+1}, H_k = P_{k+1}^H hbar P_k and right-hand side
+/// P_{k+1}^H (c - hbar y) are exact (the harmonic Ritz residuals are parallel to the GMRES
+/// residual). Convergence is judged on the true residual after every cycle as in gmres; where
+/// the coordinate residual disagrees with the true one (lost orthogonality) or H_m is singular,
+/// the restart is a plain one from the true residual.
+template <class S, class Op, class Pre>
+krylov_report gmres_deflated(const Op& a, const Pre& m_pre, const vec<S>& b, vec<S>& x, const krylov_options& opt) {
+  internal::krylov_state<S, Op, Pre> st("GMRES-DR", a, m_pre, b, x, opt);
+  if (st.zero_rhs()) return st.zero_solution();
+  using real = real_of_t<S>;
+  using mat = Eigen::Matrix<S, Eigen::Dynamic, Eigen::Dynamic>;
+  const Eigen::Index n = b.size();
+  const int m = st.basis_size();
+  const int k = opt.deflation;
+  const int kmax = std::min(k + 1, m - 2);  // a real S keeps a split pair whole
+  vec<S> r(n), w(n), z(n);
+  double beta = st.true_residual(r, w);
+  st.rep.initial_residual = beta / st.scale();
+  st.record(beta);
+  mat v(n, m + 1), vk(n, kmax + 1);
+  mat hbar = mat::Zero(m + 1, m), rr = mat::Zero(m + 1, m), q, p(m + 1, kmax + 1);
+  vec<S> c = vec<S>::Zero(m + 1), g(m + 1), hc(m + 1), hc2(m + 1), res(m + 1);
+  std::vector<krylov_rotation<S>> rot;
+  rot.reserve(static_cast<std::size_t>(kmax * (kmax + 1) / 2 + m));
+  std::string reason;
+  int kk = 0;  // carried-over columns with a known H block
+  bool fresh = true;
+  while (true) {
+    if (!std::isfinite(beta)) {
+      reason = "non-finite residual";
+      break;
+    }
+    if (beta <= st.target || st.out_of_iterations()) break;
+    if (fresh) {  // plain (re)start from the true residual
+      kk = 0;
+      v.col(0) = r / S(beta);
+      c.setZero();
+      c(0) = S(beta);
+      hbar.setZero();
+    }
+    // QR of the carried-over (kk+1) x kk block by rotations, bottom-up in each column
+    rot.clear();
+    rr.setZero();
+    rr.topLeftCorner(kk + 1, kk) = hbar.topLeftCorner(kk + 1, kk);
+    g = c;
+    for (int i = 0; i < kk; ++i)
+      for (int row = kk - 1; row >= i; --row) {
+        krylov_rotation<S> rt;
+        if (!krylov_rotation<S>::make(row, rr(row, i), rr(row + 1, i), rt)) continue;
+        for (int j = i + 1; j < kk; ++j) rt.apply(rr.col(j));
+        rt.apply(g);
+        rot.push_back(rt);
+      }
+    int j = kk;
+    bool breakdown = false;
+    while (j < m && !st.out_of_iterations()) {
+      z = v.col(j);
+      st.pre(z, r);  // r as scratch: M^{-1} v_j
+      st.op(r, w);
+      real hn;
+      {  // classical Gram-Schmidt, the second pass where needed (as in gmres)
+        const auto vj = v.leftCols(j + 1);
+        auto hj = hc.head(j + 1);
+        const real before = opt.reorthogonalize ? st.norm(w) : real(0);
+        hj.noalias() = vj.adjoint() * w;
+        st.global_sum(hj);
+        w.noalias() -= vj * hj;
+        hn = st.norm(w);
+        if (opt.reorthogonalize && !(hn > real(opt.reorthogonalization_threshold) * before)) {
+          auto h2 = hc2.head(j + 1);
+          h2.noalias() = vj.adjoint() * w;
+          st.global_sum(h2);
+          w.noalias() -= vj * h2;
+          hj += h2;
+          hn = st.norm(w);
+        }
+        hbar.col(j).head(j + 1) = hj;
+        hbar(j + 1, j) = S(hn);
+      }
+      auto col = rr.col(j);
+      col.head(j + 2) = hbar.col(j).head(j + 2);
+      for (const auto& rt : rot) rt.apply(col);
+      krylov_rotation<S> rt;
+      if (!krylov_rotation<S>::make(j, col(j), col(j + 1), rt)) {  // singular
+        breakdown = true;
+        break;
+      }
+      rt.apply(g);
+      rot.push_back(rt);
+      ++st.rep.iterations;
+      const double est = static_cast<double>(std::abs(g(j + 1)));
+      st.record(est);
+      ++j;
+      if (!std::isfinite(est)) break;
+      if (hn == real(0)) {
+        breakdown = true;
+        break;
+      }
+      if (est <= st.target) break;
+      v.col(j) = w / S(hn);
+    }
+    if (j == 0) break;  // singular at the first step
+    const vec<S> y = rr.topLeftCorner(j, j).template triangularView<Eigen::Upper>().solve(g.head(j));
+    w.noalias() = v.leftCols(j) * y;
+    st.pre(w, z);
+    x += z;
+    beta = st.true_residual(r, w);
+    if (breakdown && beta > st.target) {
+      reason = "breakdown (singular preconditioned operator?)";
+      break;
+    }
+    fresh = true;
+    if (j < m || beta <= st.target || st.out_of_iterations() || !std::isfinite(beta)) continue;
+    // deflated restart
+    res = c;
+    res.noalias() -= hbar * y;
+    if (!(std::abs(static_cast<double>(res.norm()) - beta) <= 1e-6 * beta)) continue;  // lost orthogonality
+    if constexpr (distributed_operator<Op, real>) {
+      // the same small matrices on every process (their reductions may differ in the last bits
+      // between processes, and the choice of Ritz vectors is discrete): the processes' mean
+      const real processes = st.global_sum(real(1));
+      st.global_sum(hbar);
+      hbar /= S(processes);
+      st.global_sum(res);
+      res /= S(processes);
+    }
+    const int kn = harmonic_ritz_basis(hbar, m, k, kmax, q);
+    if (kn == 0) continue;
+    p.setZero();
+    p.topLeftCorner(m, kn) = q.leftCols(kn);
+    auto pr = p.col(kn);
+    pr = res;
+    for (int pass = 0; pass < 2; ++pass) pr -= p.leftCols(kn) * (p.leftCols(kn).adjoint() * pr);
+    const real prn = pr.norm();
+    if (!(prn > real(1e-12) * res.norm())) continue;
+    pr /= S(prn);
+    const auto pk1 = p.leftCols(kn + 1);
+    const mat hnew = pk1.adjoint() * hbar * p.topLeftCorner(m, kn);
+    c.setZero();
+    c.head(kn + 1) = pk1.adjoint() * res;
+    vk.leftCols(kn + 1).noalias() = v * pk1;
+    v.leftCols(kn + 1) = vk.leftCols(kn + 1);
+    hbar.setZero();
+    hbar.topLeftCorner(kn + 1, kn) = hnew;
+    kk = kn;
+    fresh = false;
+  }
+  return st.finish(r, w, reason);
+}
+
+}  // namespace internal
+
 /// Right-preconditioned restarted GMRES(m) (Arnoldi with classical Gram-Schmidt, twice where needed,
 /// complex Givens rotations). The solution update M^{-1}(V y) is formed once per cycle, so no preconditioned
 /// basis is stored (n (m+1) scalars of memory).
 template <class S, class Op, class Pre>
 krylov_report gmres(const Op& a, const Pre& m_pre, const vec<S>& b, vec<S>& x, const krylov_options& opt = {}) {
+  if (opt.deflation > 0 && opt.deflation + 2 <= std::min(opt.restart, std::max(opt.max_iterations, 1)))
+    return internal::gmres_deflated(a, m_pre, b, x, opt);
   internal::krylov_state<S, Op, Pre> st("GMRES", a, m_pre, b, x, opt);
   if (st.zero_rhs()) return st.zero_solution();
   using real = real_of_t<S>;
