@@ -199,11 +199,10 @@ std::vector<boundary_run> boundaries(const flutter_options& o, const std::filesy
   const models::flutter_reference ref = agard_reference(wing.planform);
   std::vector<int> strides = o.strides;
   if (o.vg_stride) strides.push_back(o.vg_stride);
-  // the finer levels' dampings first, in their listed order: on a finer level the first of them
-  // starts from the coarser boundary (grid sequencing), each later one from the same level's
-  // boundary at the nearest damping done (continuation in damping; the medium grid's boundary
-  // without damping started from the coarse one converges to the trivial Hopf point mu = 0),
-  // and where that fails, by grid sequencing
+  // the finer levels' dampings first, in their listed order: on a finer level each starts from
+  // the coarser boundary (grid sequencing), and where that fails (e.g. lands on the trivial Hopf
+  // point mu = 0, below the family's mu_min) from the same level's boundary at the nearest
+  // damping done (continuation in damping, flutter_boundary_options::start_point)
   std::vector<double> order;
   for (double z : o.fine_damping_percent)
     if (std::find(o.damping_percent.begin(), o.damping_percent.end(), z) != o.damping_percent.end() &&
@@ -238,18 +237,17 @@ std::vector<boundary_run> boundaries(const flutter_options& o, const std::filesy
         if (finer && q.stride == s && !q.b.points.empty() && std::abs(q.b.points.front().mach - o.machs.front()) < 1e-9 &&
             (!neighbour || std::abs(q.damping - zeta) < std::abs(neighbour->damping - zeta)))
           neighbour = &q;
-      if (neighbour) {  // Newton from its point (flutter_boundary_options::start_point)
-        fo.start_point = neighbour->b.points.front().point;
-        output([&] { std::printf("  first point from the %g %% boundary's on this grid\n", neighbour->damping); });
-      }
       const auto t0 = std::chrono::steady_clock::now();
       boundary_run r{s, zeta, {}, 0};
       try {
         r.b = trace_flutter_boundary(family, s, o.machs, coarser, fo);
       } catch (const convergence_error& e) {  // thrown alike on every rank (the same decisions everywhere)
-        if (!fo.start_point || !coarser) throw;
-        output([&] { std::printf("  %s\n  grid sequencing from the coarser boundary instead\n", e.what()); });
-        fo.start_point.reset();
+        if (!neighbour) throw;
+        output([&] {
+          std::printf("  %s\n  first point by Newton from the %g %% boundary's on this grid instead\n", e.what(),
+                      neighbour->damping);
+        });
+        fo.start_point = neighbour->b.points.front().point;
         r.b = trace_flutter_boundary(family, s, o.machs, coarser, fo);
       }
       r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

@@ -18,8 +18,8 @@
 //   --fine-grid    also write the fine level's Plot3D file (1.5 M points, 37 MB)
 //   --flutter L    boundary levels, e.g. coarse,medium (default; none: no boundaries)
 //   --damping P    structural damping ratios in percent on the coarsest level (default 0,0.5,2)
-//   --fine-damping P   those of them also run on the finer levels (default 0.5): the first from the
-//                  coarser level's boundary, each further one from this level's at the nearest damping
+//   --fine-damping P   those of them also run on the finer levels (default 0.5), each from the coarser
+//                  level's boundary, or where that fails from this level's at the nearest damping done
 //   --machs LIST   Mach numbers of the boundaries (default 0.499,0.678,0.901,0.96, the experiment's)
 //   --vg L         V-g / V-f diagram on level L (default none)   --vg-mach M (default 0.96)
 //   --march L      time-marching verification at 0.95 / 1.05 mu* on level L at the V-g Mach number
