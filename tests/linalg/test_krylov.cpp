@@ -109,17 +109,21 @@ TEST(Krylov, AllMethodsRealBlock4) { check_all_methods<double, 4>(0.0, 4); }
 TEST(Krylov, AllMethodsComplexShiftedBlock5) { check_all_methods<cd, 5>(0.8, 5); }
 TEST(Krylov, AllMethodsComplexShiftedDynamic3) { check_all_methods<cd, Eigen::Dynamic>(1.5, 3); }
 
+// A block matrix as a distributed operator (global_sum: distributed/mpi_euler.hpp) of one process.
+namespace {
+struct one_process {
+  const block_sparse_matrix<double, 4>* a;
+  mutable int sums = 0;
+  Eigen::Index rows() const { return a->rows(); }
+  void apply(const vec<double>& x, vec<double>& y) const { a->multiply(x, y); }
+  void global_sum(double*, int) const { ++sums; }
+};
+}  // namespace
+
 // A distributed operator (global_sum: distributed/mpi_euler.hpp) on one process: GMRES forms
 // every inner product and norm through global_sum, with the same bits as the local path.
 TEST(Krylov, DistributedOperatorOnOneProcessGivesTheLocalIterates) {
   const auto a = convection_diffusion<double, 4>(12, 10, 4, 2.0, 1.0, 3);
-  struct one_process {
-    const block_sparse_matrix<double, 4>* a;
-    mutable int sums = 0;
-    Eigen::Index rows() const { return a->rows(); }
-    void apply(const vec<double>& x, vec<double>& y) const { a->multiply(x, y); }
-    void global_sum(double*, int) const { ++sums; }
-  };
   static_assert(distributed_operator<one_process, double>);
   const one_process d{&a};
   block_ilu<double, 4> ilu;
@@ -322,13 +326,6 @@ TEST(Krylov, DeflatedRestartsKeepTheSmallEigenvaluesAndGiveTheDirectSolution) {
 
 TEST(Krylov, DeflatedGmresOnADistributedOperatorGivesTheLocalIterates) {
   const auto a = convection_diffusion<double, 4>(20, 20, 4, 0.5, 0.5, 3);
-  struct one_process {
-    const block_sparse_matrix<double, 4>* a;
-    mutable int sums = 0;
-    Eigen::Index rows() const { return a->rows(); }
-    void apply(const vec<double>& x, vec<double>& y) const { a->multiply(x, y); }
-    void global_sum(double*, int) const { ++sums; }
-  };
   const one_process d{&a};
   const vec<double> b = vec<double>::Random(a.rows());
   krylov_options o;

@@ -156,6 +156,27 @@ struct krylov_state {
     else return v.norm();
   }
 
+  /// w -= V (V^H w) by classical Gram-Schmidt, the second pass where the first cancelled most of
+  /// w (the DGKS test, krylov_options): as stable as modified Gram-Schmidt, and matrix-vector
+  /// passes over the basis instead of one dot/axpy pair per column. hj gets V^H w (h2: scratch of
+  /// its size); returns ||w|| after.
+  template <class Basis, class Coef>
+  real orthogonalize(const Basis& vj, vec<S>& w, Coef hj, Coef h2) {
+    const real before = opt.reorthogonalize ? norm(w) : real(0);
+    hj.noalias() = vj.adjoint() * w;
+    global_sum(hj);
+    w.noalias() -= vj * hj;
+    real hn = norm(w);
+    if (opt.reorthogonalize && !(hn > real(opt.reorthogonalization_threshold) * before)) {
+      h2.noalias() = vj.adjoint() * w;
+      global_sum(h2);
+      w.noalias() -= vj * h2;
+      hj += h2;
+      hn = norm(w);
+    }
+    return hn;
+  }
+
   /// Checks everything the caller passed (x untouched until they pass); x empty = zero guess.
   krylov_state(const char* name, const Op& a_, const Pre& m_, const vec<S>& b_, vec<S>& x_, const krylov_options& o)
       : a(a_), m(m_), b(b_), x(x_), opt(o), where(concat(o.context, ": ", name)) {
@@ -399,26 +420,9 @@ krylov_report gmres_deflated(const Op& a, const Pre& m_pre, const vec<S>& b, vec
       z = v.col(j);
       st.pre(z, r);  // r as scratch: M^{-1} v_j
       st.op(r, w);
-      real hn;
-      {  // classical Gram-Schmidt, the second pass where needed (as in gmres)
-        const auto vj = v.leftCols(j + 1);
-        auto hj = hc.head(j + 1);
-        const real before = opt.reorthogonalize ? st.norm(w) : real(0);
-        hj.noalias() = vj.adjoint() * w;
-        st.global_sum(hj);
-        w.noalias() -= vj * hj;
-        hn = st.norm(w);
-        if (opt.reorthogonalize && !(hn > real(opt.reorthogonalization_threshold) * before)) {
-          auto h2 = hc2.head(j + 1);
-          h2.noalias() = vj.adjoint() * w;
-          st.global_sum(h2);
-          w.noalias() -= vj * h2;
-          hj += h2;
-          hn = st.norm(w);
-        }
-        hbar.col(j).head(j + 1) = hj;
-        hbar(j + 1, j) = S(hn);
-      }
+      const real hn = st.orthogonalize(v.leftCols(j + 1), w, hc.head(j + 1), hc2.head(j + 1));
+      hbar.col(j).head(j + 1) = hc.head(j + 1);
+      hbar(j + 1, j) = S(hn);
       auto col = rr.col(j);
       col.head(j + 2) = hbar.col(j).head(j + 2);
       for (const auto& rt : rot) rt.apply(col);
@@ -527,27 +531,8 @@ krylov_report gmres(const Op& a, const Pre& m_pre, const vec<S>& b, vec<S>& x, c
       z = v.col(j);
       st.pre(z, r);  // r used as scratch: M^{-1} v_j
       st.op(r, w);
-      real hn;
-      {  // classical Gram-Schmidt, the second pass where the first cancelled most of w (the DGKS
-         // test, krylov_options): as stable as modified Gram-Schmidt, and matrix-vector passes
-         // over the basis instead of j+1 dot/axpy pairs
-        const auto vj = v.leftCols(j + 1);
-        auto hj = hc.head(j + 1);
-        const real before = opt.reorthogonalize ? st.norm(w) : real(0);
-        hj.noalias() = vj.adjoint() * w;
-        st.global_sum(hj);
-        w.noalias() -= vj * hj;
-        hn = st.norm(w);
-        if (opt.reorthogonalize && !(hn > real(opt.reorthogonalization_threshold) * before)) {
-          auto h2 = hc2.head(j + 1);
-          h2.noalias() = vj.adjoint() * w;
-          st.global_sum(h2);
-          w.noalias() -= vj * h2;
-          hj += h2;
-          hn = st.norm(w);
-        }
-        h.col(j).head(j + 1) = hj;
-      }
+      const real hn = st.orthogonalize(v.leftCols(j + 1), w, hc.head(j + 1), hc2.head(j + 1));
+      h.col(j).head(j + 1) = hc.head(j + 1);
       for (int i = 0; i < j; ++i) {  // previous rotations
         const S t = cs(i) * h(i, j) + sn(i) * h(i + 1, j);
         h(i + 1, j) = -Eigen::numext::conj(sn(i)) * h(i, j) + cs(i) * h(i + 1, j);
