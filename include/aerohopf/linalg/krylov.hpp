@@ -177,6 +177,19 @@ struct krylov_state {
     return hn;
   }
 
+  /// End of a GMRES cycle of j steps: y = R^{-1} g (R the leading j x j upper triangle of the
+  /// rotated Hessenberg matrix), x += M^{-1} V y, r = b - A x and beta = ||r||; returns y.
+  template <class Mat>
+  vec<S> cycle_update(const Mat& rmat, const vec<S>& g, const Mat& v, int j, vec<S>& r, vec<S>& w, vec<S>& z,
+                      double& beta) {
+    const vec<S> y = rmat.topLeftCorner(j, j).template triangularView<Eigen::Upper>().solve(g.head(j));
+    w.noalias() = v.leftCols(j) * y;
+    pre(w, z);
+    x += z;
+    beta = true_residual(r, w);
+    return y;
+  }
+
   /// Checks everything the caller passed (x untouched until they pass); x empty = zero guess.
   krylov_state(const char* name, const Op& a_, const Pre& m_, const vec<S>& b_, vec<S>& x_, const krylov_options& o)
       : a(a_), m(m_), b(b_), x(x_), opt(o), where(concat(o.context, ": ", name)) {
@@ -446,11 +459,7 @@ krylov_report gmres_deflated(const Op& a, const Pre& m_pre, const vec<S>& b, vec
       v.col(j) = w / S(hn);
     }
     if (j == 0) break;  // singular at the first step
-    const vec<S> y = rr.topLeftCorner(j, j).template triangularView<Eigen::Upper>().solve(g.head(j));
-    w.noalias() = v.leftCols(j) * y;
-    st.pre(w, z);
-    x += z;
-    beta = st.true_residual(r, w);
+    const vec<S> y = st.cycle_update(rr, g, v, j, r, w, z, beta);
     if (breakdown && beta > st.target) {
       reason = "breakdown (singular preconditioned operator?)";
       break;
@@ -568,12 +577,7 @@ krylov_report gmres(const Op& a, const Pre& m_pre, const vec<S>& b, vec<S>& x, c
       if (est <= st.target) break;
       v.col(j) = w / S(hn);
     }
-    // y = H^{-1} g; x += M^{-1} V y
-    const vec<S> y = h.topLeftCorner(j, j).template triangularView<Eigen::Upper>().solve(g.head(j));
-    w.noalias() = v.leftCols(j) * y;
-    st.pre(w, z);
-    x += z;
-    beta = st.true_residual(r, w);
+    st.cycle_update(h, g, v, j, r, w, z, beta);
     if (breakdown && beta > st.target) {
       reason = "breakdown (singular preconditioned operator?)";
       break;
