@@ -368,8 +368,18 @@ TEST(HarmonicBalance, KrylovStrategyEqualsSparseLuOnTheAerofoil) {
   EXPECT_LE(sp.residual, ho.tolerance);
   EXPECT_LE(std::abs(sp.linear_iterations - krylov.linear_iterations), 3)
       << sp.linear_iterations << " vs " << krylov.linear_iterations;
+  // short deflated GMRES cycles (GMRES-DR(10, 4)): the same cycle
+  hb_krylov<4> deflated;
+  deflated.restart = 10;
+  deflated.deflation = 4;
+  const lco_solution dr = solve_lco(s, g, e, lco_fix::amplitude, std::nullopt, ho, deflated);
+  EXPECT_NEAR(dr.mu, direct.mu, 1e-8 * std::abs(direct.mu));
+  EXPECT_NEAR(dr.omega, direct.omega, 1e-8 * direct.omega);
   hb_krylov<4> bad;
   bad.eta_max = 1;
+  EXPECT_THROW(solve_lco(s, g, e, lco_fix::amplitude, std::nullopt, ho, bad), input_error);
+  bad = {};
+  bad.deflation = bad.restart - 1;
   EXPECT_THROW(solve_lco(s, g, e, lco_fix::amplitude, std::nullopt, ho, bad), input_error);
 }
 
@@ -417,9 +427,18 @@ TEST(HarmonicBalance, KrylovHillExponentsEqualTheDenseOnesAndTheClosedForms) {
       EXPECT_TRUE(k.stable);
       EXPECT_GE(k.exponents.size(), 2u);
     }
+    {  // short deflated GMRES cycles (GMRES-DR(6, 3)): the same exponents
+      hill_krylov_options ho;
+      ho.restart = 6;
+      ho.deflation = 3;
+      expect_krylov_matches_dense(hill_floquet_krylov<2>(r, c, ho), hill_floquet(r, c), 1e-7);
+    }
     // the options are checked
     hill_krylov_options bad;
     bad.subspace = bad.exponents + 2;
+    EXPECT_THROW(hill_floquet_krylov<2>(r, c, bad), input_error);
+    bad = {};
+    bad.deflation = bad.restart - 1;
     EXPECT_THROW(hill_floquet_krylov<2>(r, c, bad), input_error);
     bad = {};
     bad.max_iterations = 1;
