@@ -458,7 +458,10 @@ krylov_report gmres_deflated(const Op& a, const Pre& m_pre, const vec<S>& b, vec
       if (est <= st.target) break;
       v.col(j) = w / S(hn);
     }
-    if (j == 0) break;  // singular at the first step
+    if (j == 0) {  // A M^{-1} v_0 = 0 at the first step
+      reason = "breakdown (singular preconditioned operator?)";
+      break;
+    }
     const vec<S> y = st.cycle_update(rr, g, v, j, r, w, z, beta);
     if (breakdown && beta > st.target) {
       reason = "breakdown (singular preconditioned operator?)";
