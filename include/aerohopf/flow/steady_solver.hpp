@@ -88,6 +88,17 @@ struct steady_report {
   std::vector<std::string> rejections;  // one line per rejected step: step, cause, CFL_0 after
 };
 
+/// The GMRES of each pseudo-time step: steady_options' linear solver settings.
+inline krylov_options steady_krylov_options(const steady_options& o) {
+  krylov_options ko;
+  ko.relative_tolerance = o.linear_tolerance;
+  ko.max_iterations = o.linear_max_iterations;
+  ko.restart = o.restart;
+  ko.deflation = o.deflation;
+  ko.record_history = false;
+  return ko;
+}
+
 /// Throws input_error naming the option and its value unless o is finite and in range.
 inline void check_steady_options(const steady_options& o, const char* who) {
   require(std::isfinite(o.cfl_initial) && o.cfl_initial > 0, who, ": cfl_initial must be finite and > 0 (got ",
@@ -106,9 +117,7 @@ inline void check_steady_options(const steady_options& o, const char* who) {
           ": linear_tolerance must lie in (0, 1) (got ", o.linear_tolerance, ")");
   require(o.linear_max_iterations >= 1, who, ": linear_max_iterations must be >= 1 (got ", o.linear_max_iterations,
           ")");
-  require(o.restart >= 1, who, ": restart must be >= 1 (got ", o.restart, ")");
-  require(o.deflation >= 0 && (o.deflation == 0 || o.deflation + 2 <= o.restart), who,
-          ": deflation must be 0 or in [1, restart - 2] (got ", o.deflation, ", restart ", o.restart, ")");
+  validate_krylov_options(steady_krylov_options(o), who);  // restart, deflation
   require(o.stall_steps >= 0 && std::isfinite(o.stall_factor) && o.stall_factor > 0 && o.stall_factor < 1, who,
           ": need stall_steps >= 0 and stall_factor in (0, 1) (got ", o.stall_steps, ", ", o.stall_factor, ")");
   require(o.fill_level >= 0 && o.fill_level <= 8, who, ": fill_level must lie in [0, 8] (got ", o.fill_level, ")");
@@ -350,12 +359,7 @@ steady_report solve_steady(D& d, vec<double>& w, const steady_options& opt) {
         ilu.factorize(pa);
       });
       analysed = true;
-      krylov_options ko;
-      ko.relative_tolerance = opt.linear_tolerance;
-      ko.max_iterations = opt.linear_max_iterations;
-      ko.restart = opt.restart;
-      ko.deflation = opt.deflation;
-      ko.record_history = false;
+      const krylov_options ko = steady_krylov_options(opt);
       vec<double> dw = vec<double>::Zero(w.size());
       lin = d.gmres(kind == jacobian_kind::exact ? ax : a, ilu, r, dw, ko);
       rep.linear_iterations += lin.iterations;

@@ -525,8 +525,9 @@ krylov_report gmres(const Op& a, const Pre& m_pre, const vec<S>& b, vec<S>& x, c
   st.rep.initial_residual = beta / st.scale();
   st.record(beta);
   Eigen::Matrix<S, Eigen::Dynamic, Eigen::Dynamic> v(n, m + 1), h = Eigen::Matrix<S, Eigen::Dynamic, Eigen::Dynamic>::Zero(m + 1, m);
-  vec<S> g(m + 1), sn(m), hc(m + 1), hc2(m + 1);
-  Eigen::Matrix<real, Eigen::Dynamic, 1> cs(m);
+  vec<S> g(m + 1), hc(m + 1), hc2(m + 1);
+  std::vector<internal::krylov_rotation<S>> rot;
+  rot.reserve(static_cast<std::size_t>(m));
   std::string reason;
   while (true) {
     if (!std::isfinite(beta)) {
@@ -537,6 +538,7 @@ krylov_report gmres(const Op& a, const Pre& m_pre, const vec<S>& b, vec<S>& x, c
     v.col(0) = r / S(beta);
     g.setZero();
     g(0) = S(beta);
+    rot.clear();
     int j = 0;
     bool breakdown = false;
     while (j < m && !st.out_of_iterations()) {
@@ -544,30 +546,17 @@ krylov_report gmres(const Op& a, const Pre& m_pre, const vec<S>& b, vec<S>& x, c
       st.pre(z, r);  // r used as scratch: M^{-1} v_j
       st.op(r, w);
       const real hn = st.orthogonalize(v.leftCols(j + 1), w, hc.head(j + 1), hc2.head(j + 1));
-      h.col(j).head(j + 1) = hc.head(j + 1);
-      for (int i = 0; i < j; ++i) {  // previous rotations
-        const S t = cs(i) * h(i, j) + sn(i) * h(i + 1, j);
-        h(i + 1, j) = -Eigen::numext::conj(sn(i)) * h(i, j) + cs(i) * h(i + 1, j);
-        h(i, j) = t;
-      }
-      // new rotation annihilating hn below h(j, j)
-      const S hjj = h(j, j);
-      const real ah = std::abs(hjj), nu = std::sqrt(ah * ah + hn * hn);
-      if (nu == real(0)) {  // A M^{-1} v_j in span(v_0..v_{j-1}) and h_jj = 0: singular
-        breakdown = true;
+      auto col = h.col(j);  // rotated in place: R of the cycle's QR
+      col.head(j + 1) = hc.head(j + 1);
+      col(j + 1) = S(hn);
+      for (const auto& rt : rot) rt.apply(col);
+      internal::krylov_rotation<S> rt;
+      if (!internal::krylov_rotation<S>::make(j, col(j), col(j + 1), rt)) {
+        breakdown = true;  // A M^{-1} v_j in span(v_0..v_{j-1}) and h_jj = 0: singular
         break;
       }
-      if (ah == real(0)) {
-        cs(j) = 0;
-        sn(j) = S(1.0);
-      } else {
-        cs(j) = ah / nu;
-        sn(j) = (hjj / ah) * S(hn / nu);
-      }
-      h(j, j) = ah == real(0) ? S(hn) : (hjj / ah) * S(nu);
-      h(j + 1, j) = S(0.0);
-      g(j + 1) = -Eigen::numext::conj(sn(j)) * g(j);
-      g(j) = cs(j) * g(j);
+      rt.apply(g);
+      rot.push_back(rt);
       ++st.rep.iterations;
       const double est = static_cast<double>(std::abs(g(j + 1)));
       st.record(est);
