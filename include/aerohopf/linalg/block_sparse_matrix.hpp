@@ -623,12 +623,12 @@ template <class Op, class S>
 class bordered_operator {
  public:
   using matrix = Eigen::Matrix<S, Eigen::Dynamic, Eigen::Dynamic>;
-  bordered_operator(const Op& a, Eigen::Index n, matrix border_columns, matrix border_rows, matrix corner)
-      : a_(&a), n_(n), u_(std::move(border_columns)), vt_(std::move(border_rows)), d_(std::move(corner)) {
+  bordered_operator(const Op& a, Eigen::Index n, matrix border_columns, const matrix& border_rows, matrix corner)
+      : a_(&a), n_(n), u_(std::move(border_columns)), v_(border_rows.transpose()), d_(std::move(corner)) {
     const auto k = d_.rows();
-    require(d_.cols() == k && u_.rows() == n && u_.cols() == k && vt_.rows() == k && vt_.cols() == n,
-            "bordered_operator: border columns ", u_.rows(), "x", u_.cols(), ", border rows ", vt_.rows(), "x",
-            vt_.cols(), ", corner ", d_.rows(), "x", d_.cols(), " inconsistent with n = ", n);
+    require(d_.cols() == k && u_.rows() == n && u_.cols() == k && v_.cols() == k && v_.rows() == n,
+            "bordered_operator: border columns ", u_.rows(), "x", u_.cols(), ", border rows ", v_.cols(), "x",
+            v_.rows(), ", corner ", d_.rows(), "x", d_.cols(), " inconsistent with n = ", n);
     require_operator_size(a, n, "bordered_operator", "inner operator");
     x1_.resize(n);
     y1_.resize(n);
@@ -636,7 +636,7 @@ class bordered_operator {
   Eigen::Index rows() const { return n_ + d_.rows(); }
   Eigen::Index border_size() const { return d_.rows(); }
   const matrix& border_columns() const { return u_; }
-  const matrix& border_rows() const { return vt_; }
+  auto border_rows() const { return v_.transpose(); }  ///< V^T (k x n)
   const matrix& corner() const { return d_; }
   const Op& inner_operator() const { return *a_; }
 
@@ -648,14 +648,14 @@ class bordered_operator {
     const auto k = d_.rows();
     y.head(n_) = y1_;
     y.head(n_).noalias() += u_ * x.tail(k);
-    y.tail(k).noalias() = vt_ * x1_;
+    y.tail(k).noalias() = v_.transpose() * x1_;  // k dot products (a k x n matrix times x: 2-5x slower)
     y.tail(k).noalias() += d_ * x.tail(k);
   }
 
  private:
   const Op* a_;
   Eigen::Index n_;
-  matrix u_, vt_, d_;
+  matrix u_, v_, d_;  // v_ = V (n x k): the border rows stored as columns
   mutable vec<S> x1_, y1_;
 };
 
@@ -669,8 +669,8 @@ template <class S>
 class border_elimination {
  public:
   using matrix = Eigen::Matrix<S, Eigen::Dynamic, Eigen::Dynamic>;
-  template <class Pre>
-  void compute(const Pre& m, Eigen::Index n, const matrix& border_columns, const matrix& border_rows,
+  template <class Pre, class Rows>
+  void compute(const Pre& m, Eigen::Index n, const matrix& border_columns, const Eigen::MatrixBase<Rows>& border_rows,
                const matrix& corner, std::string_view who) {
     const auto k = corner.rows();
     require(corner.cols() == k && border_columns.rows() == n && border_columns.cols() == k && border_rows.rows() == k &&
@@ -689,7 +689,7 @@ class border_elimination {
       w_.col(c) = z1_;
     }
     const matrix schur = corner - border_rows * w_;
-    vt_ = border_rows;
+    v_ = border_rows.transpose();
     if (!schur.allFinite()) throw singular_matrix_error(internal::concat(who, ": non-finite Schur complement"));
     schur_.compute(schur);
     if (k > 0 && !(std::abs(schur_.determinant()) > 0))
@@ -706,7 +706,7 @@ class border_elimination {
     r1_ = r.head(n_);
     apply_operator<S>(m, r1_, z1_);
     t_ = r.tail(k);
-    t_.noalias() -= vt_ * z1_;
+    t_.noalias() -= v_.transpose() * z1_;
     s_ = schur_.solve(t_);
     z.head(n_) = z1_;
     z.head(n_).noalias() -= w_ * s_;
@@ -715,7 +715,7 @@ class border_elimination {
 
  private:
   Eigen::Index n_ = 0;
-  matrix w_, vt_;
+  matrix w_, v_;  // W = M^{-1} U and V (n x k; V^T z as k dot products)
   Eigen::PartialPivLU<matrix> schur_;
   mutable vec<S> r1_, z1_, t_, s_;
 };

@@ -642,15 +642,16 @@ struct hb_krylov {
                   o_.preconditioner, who_);
       // the full operator [[Hill, U], [V, corner]]
       const Eigen::MatrixXd dw = w * eq.differentiation().transpose();
-      Eigen::MatrixXd u = Eigen::MatrixXd::Zero(m, 3), v = Eigen::MatrixXd::Zero(3, m), corner = Eigen::MatrixXd::Zero(3, 3);
+      // the border rows stored as columns (vt = V^T is m x 3): V z as three dot products
+      Eigen::MatrixXd u = Eigen::MatrixXd::Zero(m, 3), vt = Eigen::MatrixXd::Zero(m, 3), corner = Eigen::MatrixXd::Zero(3, 3);
       for (int j = 0; j < nn; ++j) {
         const vec<double> wj = w.col(j);
         u.block(j * n, 0, n, 1) = -dw.col(j);
         u.block(j * n, 1, n, 1) = residual_d_mu(*sys_, wj, mu);
       }
-      v.row(0) = eq.phase_row().transpose();
-      v.row(1) = eq.amplitude_row().transpose();
-      v.row(2) = c.head(m).transpose();
+      vt.col(0) = eq.phase_row();
+      vt.col(1) = eq.amplitude_row();
+      vt.col(2) = c.head(m);
       corner(1, 2) = -1;
       corner.row(2) = c.tail(3).transpose();
       state_in_.resize(m);
@@ -660,21 +661,15 @@ struct hb_krylov {
         hill_.apply(state_in_, state_out_);
         y.head(m) = state_out_;
         y.head(m).noalias() += u * z.tail(3);
-        y.tail(3).noalias() = v * z.head(m);
+        y.tail(3).noalias() = vt.transpose() * z.head(m);
         y.tail(3).noalias() += corner * z.tail(3);
       };
       auto state_pre = [&](const vec<double>& r, vec<double>& z) { hill_.precondition(r, z); };
       internal::border_elimination<double> border;
-      border.compute(state_pre, m, u, v, corner, internal::concat(who_, ": harmonic-balance border"));
+      border.compute(state_pre, m, u, vt.transpose(), corner, internal::concat(who_, ": harmonic-balance border"));
       auto pre_full = [&](const vec<double>& r, vec<double>& z) { border.apply(state_pre, r, z); };
-      krylov_options ko;
-      ko.relative_tolerance = next_tolerance_.value_or(o_.relative_tolerance);
+      const krylov_options ko = o_.krylov(next_tolerance_.value_or(o_.relative_tolerance), who_);
       next_tolerance_.reset();
-      ko.max_iterations = o_.max_iterations;
-      ko.restart = o_.restart;
-      ko.deflation = o_.deflation;
-      ko.record_history = false;
-      ko.context = internal::concat(who_, ": GMRES on the harmonic-balance Jacobian");
       vec<double> dx = vec<double>::Zero(rhs.size());
       const krylov_report rep = gmres<double>(op, pre_full, rhs, dx, ko);
       iterations_ += rep.iterations;
@@ -699,15 +694,26 @@ struct hb_krylov {
     int iterations_ = 0;
     std::size_t bytes_ = 0;
   };
+  /// The GMRES options of a solve to relative tolerance tol.
+  krylov_options krylov(double tol, const char* who) const {
+    krylov_options ko;
+    ko.relative_tolerance = tol;
+    ko.max_iterations = max_iterations;
+    ko.restart = restart;
+    ko.deflation = deflation;
+    ko.record_history = false;
+    ko.context = internal::concat(who, ": GMRES on the harmonic-balance Jacobian");
+    return ko;
+  }
   template <dynamical_system S>
   solver<S> make(const internal::harmonic_balance_equations<S>& eq, const S& sys, const char* who) const {
     require(fill_level >= 0 && std::isfinite(relative_tolerance) && relative_tolerance > 0 &&
                 std::isfinite(accept_tolerance) && accept_tolerance >= relative_tolerance && max_iterations >= 1 &&
-                restart >= 1 && eta_max > 0 && eta_max < 1 && deflation >= 0 &&
-                (deflation == 0 || deflation + 2 <= restart),
+                eta_max > 0 && eta_max < 1,
             who, ": hb_krylov options out of range (fill_level ", fill_level, ", relative_tolerance ",
             relative_tolerance, ", accept_tolerance ", accept_tolerance, ", eta_max ", eta_max, ", max_iterations ",
-            max_iterations, ", restart ", restart, ", deflation ", deflation, ")");
+            max_iterations, ")");
+    validate_krylov_options(krylov(relative_tolerance, who), who);  // restart, deflation
     return solver<S>(*this, eq, sys, who);
   }
 };
