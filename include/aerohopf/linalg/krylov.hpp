@@ -118,6 +118,10 @@ inline void validate_krylov_options(const krylov_options& opt, std::string_view 
 
 namespace internal {
 
+/// Basis length of GCR(m)/GMRES(m): restart, but never more than the iterations allowed (the
+/// same iterates; a huge restart would allocate n (restart + 1) scalars for nothing).
+inline int krylov_basis_size(const krylov_options& o) { return std::min(o.restart, std::max(o.max_iterations, 1)); }
+
 /// Shared bookkeeping of the four methods: counting, history, stopping test, final report.
 template <class S, class Op, class Pre>
 struct krylov_state {
@@ -209,9 +213,7 @@ struct krylov_state {
     target = std::max(opt.relative_tolerance * rep.rhs_norm, opt.absolute_tolerance);
   }
   double scale() const { return rep.rhs_norm > 0 ? rep.rhs_norm : 1.0; }
-  /// Basis length of GCR(m)/GMRES(m): restart, but never more than the iterations allowed (the
-  /// same iterates; a huge restart would allocate n (restart + 1) scalars for nothing).
-  int basis_size() const { return std::min(opt.restart, std::max(opt.max_iterations, 1)); }
+  int basis_size() const { return krylov_basis_size(opt); }
   void op(const vec<S>& in, vec<S>& out) {
     apply_operator<S>(a, in, out);
     ++rep.operator_applications;
@@ -513,7 +515,7 @@ krylov_report gmres_deflated(const Op& a, const Pre& m_pre, const vec<S>& b, vec
 /// basis is stored (n (m+1) scalars of memory).
 template <class S, class Op, class Pre>
 krylov_report gmres(const Op& a, const Pre& m_pre, const vec<S>& b, vec<S>& x, const krylov_options& opt = {}) {
-  if (opt.deflation > 0 && opt.deflation + 2 <= std::min(opt.restart, std::max(opt.max_iterations, 1)))
+  if (opt.deflation > 0 && opt.deflation + 2 <= internal::krylov_basis_size(opt))
     return internal::gmres_deflated(a, m_pre, b, x, opt);
   internal::krylov_state<S, Op, Pre> st("GMRES", a, m_pre, b, x, opt);
   if (st.zero_rhs()) return st.zero_solution();
