@@ -29,7 +29,7 @@ import sys
 LATENCY = 2e-6          # s, point-to-point and per all-reduce stage
 BANDWIDTH = 10e9        # bytes/s per rank (InfiniBand HDR shared by a node's ranks, conservative)
 REDUCTIONS_PER_ITERATION = 3
-MAX_ITERATIONS = 200    # the steady solver's linear_max_iterations: GMRES stops there
+MAX_ITERATIONS = 200    # the steady solver's krylov.max_iterations: GMRES stops there
 
 
 def read(path):

@@ -189,6 +189,34 @@ TEST(mpi_hopf, start_refinement_as_the_serial_one) {
   EXPECT_FALSE(distributed::solve_hopf(d, local_guess(d, start), o).start_refined);
 }
 
+// A distributed solve runs the GMRES of its serial twin: every field of the serial options'
+// krylov_options but the tolerance (the caller's forcing) carries over, the deflation included
+// (a GMRES-DR(80, 20) against a plain GMRES(300) is another solver on a hard correction).
+TEST(mpi_hopf, serial_gmres_settings_carry_over_to_the_distributed_options) {
+  hopf_krylov_options ko;
+  ko.krylov.restart = 300;
+  ko.krylov.deflation = 0;
+  ko.krylov.max_iterations = 1234;
+  ko.krylov.reorthogonalize = true;
+  ko.krylov.reorthogonalization_threshold = 0.5;
+  const distributed_hopf_options o = distributed::internal::hopf_options_from(hopf_options{}, ko);
+  EXPECT_EQ(o.krylov.restart, 300);
+  EXPECT_EQ(o.krylov.deflation, 0);
+  EXPECT_EQ(o.krylov.max_iterations, 1234);
+  EXPECT_TRUE(o.krylov.reorthogonalize);
+  EXPECT_EQ(o.krylov.reorthogonalization_threshold, 0.5);
+  EXPECT_EQ(distributed::internal::hopf_options_from(hopf_options{}, hopf_krylov_options{}).krylov.deflation,
+            hopf_krylov_options{}.krylov.deflation);
+  hopf_start_krylov_options so;
+  so.krylov.restart = 50;
+  so.krylov.deflation = 12;
+  const distributed_inverse_power_options io = distributed::internal::inverse_power_options_from(so);
+  EXPECT_EQ(io.krylov.restart, 50);
+  EXPECT_EQ(io.krylov.deflation, 12);
+  EXPECT_EQ(io.krylov.relative_tolerance, so.krylov.relative_tolerance);
+  EXPECT_EQ(io.fill_level, so.fill_level);
+}
+
 TEST(mpi_hopf, bad_input_and_failures_are_the_same_on_every_rank) {
   const auto f = family(0.0);
   const models::aerofoil_system sys = f.system(8, 0.5);

@@ -35,8 +35,8 @@ TEST(steady_solver, subsonic_symmetric_flow_converges_ten_orders) {
     }
     if (level == 8) {  // deflated restarts of short GMRES cycles: the same steady state
       steady_options d = opt;
-      d.restart = 8;
-      d.deflation = 4;
+      d.krylov.restart = 8;
+      d.krylov.deflation = 4;
       auto wd = m.free_stream_vector();
       const auto rd = solve_steady<2>(m, wd, d);
       EXPECT_TRUE(rd.converged);
@@ -197,8 +197,8 @@ TEST(steady_solver, rejects_bad_options_and_nan_state_naming_them) {
   o.residual_drop = NAN;
   refused(o, "residual_drop");
   o = {};
-  o.linear_tolerance = 0;
-  refused(o, "linear_tolerance");
+  o.krylov.relative_tolerance = 0;
+  refused(o, "krylov.relative_tolerance");
   o = {};
   o.ser_exponent = NAN;
   refused(o, "ser_exponent");
@@ -212,8 +212,8 @@ TEST(steady_solver, rejects_bad_options_and_nan_state_naming_them) {
   o.fill_level = -1;
   refused(o, "fill_level");
   o = {};
-  o.deflation = o.restart - 1;
-  refused(o, "deflation");
+  o.krylov.deflation = o.krylov.restart - 1;
+  refused(o, "krylov: deflation");
   vec<double> w = w0;
   w[5] = NAN;
   try {
@@ -232,8 +232,8 @@ TEST(steady_solver, stalled_newton_fails_clearly_naming_the_worst_cell) {
   euler_model<2> m(coarsen(naca_cgrid(), 8), {.mach = 0.5, .alpha_rad = 0.02});
   steady_options o;
   o.exact_switch_drop = 1.0;  // Newton from the first step on
-  o.linear_max_iterations = 1;
-  o.restart = 1;
+  o.krylov.max_iterations = 1;
+  o.krylov.restart = 1;
   o.stall_steps = 3;
   o.stall_factor = 0.01;
   vec<double> w = m.free_stream_vector();

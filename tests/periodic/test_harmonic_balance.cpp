@@ -313,12 +313,12 @@ TEST(HarmonicBalance, KrylovStrategyEqualsSparseLuOnTheReactor) {
   bad.fill_level = -1;
   EXPECT_THROW(solve_lco(r, g, e, lco_fix::amplitude, std::nullopt, ho, bad), input_error);
   bad = {};
-  bad.accept_tolerance = 1e-9;  // below relative_tolerance
+  bad.accept_tolerance = 1e-9;  // below krylov.relative_tolerance
   EXPECT_THROW(solve_lco(r, g, e, lco_fix::amplitude, std::nullopt, ho, bad), input_error);
   // a GMRES that cannot converge (one iteration, nothing accepted) ends the solve clearly
   bad = {};
-  bad.max_iterations = 1;
-  bad.accept_tolerance = bad.relative_tolerance;
+  bad.krylov.max_iterations = 1;
+  bad.accept_tolerance = bad.krylov.relative_tolerance;
   const std::string msg = test::error_of<convergence_error>(
       [&] { solve_lco(r, g, e, lco_fix::amplitude, std::nullopt, ho, bad); });
   EXPECT_TRUE(test::contains(msg, "GMRES on the harmonic-balance Jacobian")) << msg;
@@ -370,8 +370,8 @@ TEST(HarmonicBalance, KrylovStrategyEqualsSparseLuOnTheAerofoil) {
       << sp.linear_iterations << " vs " << krylov.linear_iterations;
   // short deflated GMRES cycles (GMRES-DR(10, 4)): the same cycle
   hb_krylov<4> deflated;
-  deflated.restart = 10;
-  deflated.deflation = 4;
+  deflated.krylov.restart = 10;
+  deflated.krylov.deflation = 4;
   const lco_solution dr = solve_lco(s, g, e, lco_fix::amplitude, std::nullopt, ho, deflated);
   EXPECT_NEAR(dr.mu, direct.mu, 1e-8 * std::abs(direct.mu));
   EXPECT_NEAR(dr.omega, direct.omega, 1e-8 * direct.omega);
@@ -379,8 +379,10 @@ TEST(HarmonicBalance, KrylovStrategyEqualsSparseLuOnTheAerofoil) {
   bad.eta_max = 1;
   EXPECT_THROW(solve_lco(s, g, e, lco_fix::amplitude, std::nullopt, ho, bad), input_error);
   bad = {};
-  bad.deflation = bad.restart - 1;
-  EXPECT_THROW(solve_lco(s, g, e, lco_fix::amplitude, std::nullopt, ho, bad), input_error);
+  bad.krylov.deflation = bad.krylov.restart - 1;
+  const std::string why =
+      test::error_of<input_error>([&] { solve_lco(s, g, e, lco_fix::amplitude, std::nullopt, ho, bad); });
+  EXPECT_TRUE(test::contains(why, "hb_krylov::krylov: deflation")) << why;
 }
 
 TEST(HarmonicBalance, KrylovHillExponentsEqualTheDenseOnesAndTheClosedForms) {
@@ -429,8 +431,8 @@ TEST(HarmonicBalance, KrylovHillExponentsEqualTheDenseOnesAndTheClosedForms) {
     }
     {  // short deflated GMRES cycles (GMRES-DR(6, 3)): the same exponents
       hill_krylov_options ho;
-      ho.restart = 6;
-      ho.deflation = 3;
+      ho.krylov.restart = 6;
+      ho.krylov.deflation = 3;
       expect_krylov_matches_dense(hill_floquet_krylov<2>(r, c, ho), hill_floquet(r, c), 1e-7);
     }
     // the options are checked
@@ -438,10 +440,11 @@ TEST(HarmonicBalance, KrylovHillExponentsEqualTheDenseOnesAndTheClosedForms) {
     bad.subspace = bad.exponents + 2;
     EXPECT_THROW(hill_floquet_krylov<2>(r, c, bad), input_error);
     bad = {};
-    bad.deflation = bad.restart - 1;
-    EXPECT_THROW(hill_floquet_krylov<2>(r, c, bad), input_error);
+    bad.krylov.deflation = bad.krylov.restart - 1;
+    const std::string why = test::error_of<input_error>([&] { hill_floquet_krylov<2>(r, c, bad); });
+    EXPECT_TRUE(test::contains(why, "krylov: deflation")) << why;
     bad = {};
-    bad.max_iterations = 1;
+    bad.krylov.max_iterations = 1;
     const std::string msg = test::error_of<convergence_error>([&] { hill_floquet_krylov<2>(r, c, bad); });
     EXPECT_TRUE(test::contains(msg, "GMRES on Hill's matrix")) << msg;
   }

@@ -218,7 +218,7 @@ class aerofoil_family : public distributed_family_base<models::aerofoil_family> 
         cache->ubar = ubar;
       }
       distributed_inverse_power_options io = internal::inverse_power_options_from(ko, power);
-      io.linear.restart = std::max(io.linear.restart, scan_min_restart);
+      io.krylov.restart = std::max(io.krylov.restart, scan_min_restart);
       vec<std::complex<double>> x0;
       if (start) x0 = r.local(*start);
       eigen_pair ep = inverse_power(d, cache->a, &cache->p, shift, io, start ? &x0 : nullptr);

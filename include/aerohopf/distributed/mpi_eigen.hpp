@@ -62,15 +62,10 @@ struct distributed_vectors {
 
 struct distributed_inverse_power_options {
   inverse_power_options power;  ///< tolerance on ||A x - lambda x|| / max(1, |lambda|), iterations
-  krylov_options linear;        ///< each shifted solve (relative tolerance 1e-9 by default: file comment)
+  /// each shifted solve: relative tolerance 1e-9 (file comment), at most 500 iterations, GMRES(100)
+  krylov_options krylov{.relative_tolerance = 1e-9, .max_iterations = 500, .restart = 100, .record_history = false};
   int fill_level = 0;           ///< k of the block-Jacobi BILU(k)
   bool single_precision_factors = false;  ///< block_ilu_options::single_precision_factors
-  distributed_inverse_power_options() {
-    linear.relative_tolerance = 1e-9;
-    linear.max_iterations = 500;
-    linear.restart = 100;
-    linear.record_history = false;
-  }
 };
 
 namespace internal {
@@ -98,7 +93,7 @@ eigen_pair run_inverse_power(MPI_Comm comm, const vec<std::complex<double>>* sta
   const double nx2 = space.squared_norm(x);
   collective(comm, who, [&] { require(nx2 > 0, who, ": start vector is zero"); });
   x /= std::sqrt(nx2);
-  krylov_options ko = opt.linear;
+  krylov_options ko = opt.krylov;
   ko.throw_on_failure = true;
   const std::string context = ko.context;
   int solve = 0;

@@ -585,17 +585,19 @@ distributed_hopf_result solve_hopf(D& d, const distributed_hopf_point& guess,
 
 namespace internal {
 
-/// GMRES's restart, iteration limit and Gram-Schmidt passes from a serial caller's options (the
-/// tolerance is the caller's forcing or its own, set apart).
+/// GMRES's restart, deflation, iteration limit and Gram-Schmidt passes from a serial caller's
+/// options, so that a distributed solve runs the GMRES its serial twin runs (the tolerance is the
+/// caller's forcing or its own, set apart).
 inline void copy_gmres_shape(const krylov_options& from, krylov_options& to) {
   to.restart = from.restart;
+  to.deflation = from.deflation;
   to.max_iterations = from.max_iterations;
   to.reorthogonalize = from.reorthogonalize;
   to.reorthogonalization_threshold = from.reorthogonalization_threshold;
 }
 
 /// The distributed Hopf options of a flutter-boundary driver's serial ones (formulation, Newton,
-/// BILU fill, GMRES restart, limit and Gram-Schmidt passes, forcing bound, start refinement):
+/// BILU fill, GMRES restart, deflation, limit and Gram-Schmidt passes, forcing bound, start refinement):
 /// the distributed families' solve_hopf.
 inline distributed_hopf_options hopf_options_from(const hopf_options& ho, const hopf_krylov_options& ko) {
   distributed_hopf_options o;
@@ -612,14 +614,14 @@ inline distributed_hopf_options hopf_options_from(const hopf_options& ho, const 
 }
 
 /// The distributed inverse-power options of a serial caller's: the eigen-residual target
-/// `power`, the BILU fill and the GMRES tolerance, restart, limit and Gram-Schmidt passes.
+/// `power`, the BILU fill and the GMRES tolerance, restart, deflation, limit and Gram-Schmidt passes.
 inline distributed_inverse_power_options inverse_power_options_from(const inverse_power_options& power, int fill_level,
                                                                     const krylov_options& krylov) {
   distributed_inverse_power_options io;
   io.power = power;
   io.fill_level = fill_level;
-  io.linear.relative_tolerance = krylov.relative_tolerance;
-  copy_gmres_shape(krylov, io.linear);
+  io.krylov.relative_tolerance = krylov.relative_tolerance;
+  copy_gmres_shape(krylov, io.krylov);
   return io;
 }
 

@@ -50,12 +50,14 @@ struct steady_options {
   int max_steps = 300;
   double residual_drop = 1e-10;       // stop when ||R|| / ||R_0|| falls below this
   double absolute_tolerance = 1e-15;  // ... or ||R|| / sqrt(n) below this
-  double linear_tolerance = 1e-2;     // relative tolerance of each GMRES solve
-  int linear_max_iterations = 200;
-  int restart = 60;
-  // k of GMRES-DR(restart, k) (krylov_options::deflation); 0: plain restarts. 20 left the AGARD
+  // The GMRES of each pseudo-time step: relative tolerance 1e-2, at most 200 iterations,
+  // GMRES(60), no residual history. krylov.deflation = k gives GMRES-DR(60, k): 20 left the AGARD
   // medium steady solve (M = 0.96, 2 ranks) at the same 24 steps and 146 s against 142 s.
-  int deflation = 0;
+  krylov_options krylov{.relative_tolerance = 1e-2,
+                        .max_iterations = 200,
+                        .restart = 60,
+                        .record_history = false,
+                        .context = "solve_steady: GMRES"};
   int fill_level = 0;                 // k of the BILU(k) preconditioner (of the modified-order matrix)
   double exact_switch_drop = 1e-3;   // exact Jacobian once ||R||/||R_0|| < this (0: never)
   // With the exact Jacobian (Newton), fail as stalled when stall_steps steps in a row have not
@@ -88,17 +90,6 @@ struct steady_report {
   std::vector<std::string> rejections;  // one line per rejected step: step, cause, CFL_0 after
 };
 
-/// The GMRES of each pseudo-time step: steady_options' linear solver settings.
-inline krylov_options steady_krylov_options(const steady_options& o) {
-  krylov_options ko;
-  ko.relative_tolerance = o.linear_tolerance;
-  ko.max_iterations = o.linear_max_iterations;
-  ko.restart = o.restart;
-  ko.deflation = o.deflation;
-  ko.record_history = false;
-  return ko;
-}
-
 /// Throws input_error naming the option and its value unless o is finite and in range.
 inline void check_steady_options(const steady_options& o, const char* who) {
   require(std::isfinite(o.cfl_initial) && o.cfl_initial > 0, who, ": cfl_initial must be finite and > 0 (got ",
@@ -113,11 +104,12 @@ inline void check_steady_options(const steady_options& o, const char* who) {
           ": absolute_tolerance must be finite and >= 0 (got ", o.absolute_tolerance, ")");
   require(o.residual_drop > 0 || o.absolute_tolerance > 0, who,
           ": residual_drop and absolute_tolerance are both 0 (no residual could be accepted)");
-  require(std::isfinite(o.linear_tolerance) && o.linear_tolerance > 0 && o.linear_tolerance < 1, who,
-          ": linear_tolerance must lie in (0, 1) (got ", o.linear_tolerance, ")");
-  require(o.linear_max_iterations >= 1, who, ": linear_max_iterations must be >= 1 (got ", o.linear_max_iterations,
+  require(std::isfinite(o.krylov.relative_tolerance) && o.krylov.relative_tolerance > 0 &&
+              o.krylov.relative_tolerance < 1,
+          who, ": krylov.relative_tolerance must lie in (0, 1) (got ", o.krylov.relative_tolerance, ")");
+  require(o.krylov.max_iterations >= 1, who, ": krylov.max_iterations must be >= 1 (got ", o.krylov.max_iterations,
           ")");
-  validate_krylov_options(steady_krylov_options(o), who);  // restart, deflation
+  validate_krylov_options(o.krylov, aerohopf::internal::concat(who, ": krylov"));  // restart, deflation
   require(o.stall_steps >= 0 && std::isfinite(o.stall_factor) && o.stall_factor > 0 && o.stall_factor < 1, who,
           ": need stall_steps >= 0 and stall_factor in (0, 1) (got ", o.stall_steps, ", ", o.stall_factor, ")");
   require(o.fill_level >= 0 && o.fill_level <= 8, who, ": fill_level must lie in [0, 8] (got ", o.fill_level, ")");
@@ -359,9 +351,8 @@ steady_report solve_steady(D& d, vec<double>& w, const steady_options& opt) {
         ilu.factorize(pa);
       });
       analysed = true;
-      const krylov_options ko = steady_krylov_options(opt);
       vec<double> dw = vec<double>::Zero(w.size());
-      lin = d.gmres(kind == jacobian_kind::exact ? ax : a, ilu, r, dw, ko);
+      lin = d.gmres(kind == jacobian_kind::exact ? ax : a, ilu, r, dw, opt.krylov);
       rep.linear_iterations += lin.iterations;
       wn = w + dw;
       rejected = non_finite(dw, "update");
@@ -426,7 +417,7 @@ steady_report solve_steady(D& d, vec<double>& w, const steady_options& opt) {
           const auto [worst_norm, cell] = d.largest_residual(r);
           return fail(aerohopf::internal::concat(
               "Newton stalled: ", opt.stall_steps, " steps with the exact Jacobian took ||R|| only from ", before, " to ",
-              best, " (GMRES at ", lin.iterations, " of at most ", opt.linear_max_iterations,
+              best, " (GMRES at ", lin.iterations, " of at most ", opt.krylov.max_iterations,
               " iterations in the last step); largest residual ", worst_norm, " in ", cell, ", at ", where()));
         }
       }

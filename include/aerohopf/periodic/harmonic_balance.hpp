@@ -596,9 +596,13 @@ struct hb_krylov {
   /// it pays where the factors stream from memory (3D grids); on the coarse aerofoil's branch
   /// (4,100 unknowns, H = 5) the GMRES iterations within one and no time saved.
   bool single_precision_factors = false;
-  /// Relative tolerance of the GMRES solves outside Newton (the curve stepper's tangents), and of
-  /// the Newton solves when adaptive_tolerance is false.
-  double relative_tolerance = 1e-6;
+  /// The GMRES: krylov.relative_tolerance is that of the solves outside Newton (the curve
+  /// stepper's tangents), and of the Newton solves when adaptive_tolerance is false (1e-6); at
+  /// most 400 iterations; GMRES(50) (against 100: a quarter less time for the coarse aerofoil's
+  /// branch, half the basis); krylov.deflation = k gives GMRES-DR(50, k) (the coarse aerofoil's
+  /// H = 5 branch to 1.05 Ubar*: 3,839 GMRES iterations with 10 against 4,023, the same time: a
+  /// solve rarely restarts, 55-90 iterations per Newton step).
+  krylov_options krylov{.relative_tolerance = 1e-6, .max_iterations = 400, .restart = 50, .record_history = false};
   /// Inexact-Newton forcing of the Newton solves, eta = min(0.5, eta_max, max(||F||_2, 0.1
   /// tolerance / ||F||_2)) (as solve_equilibrium_krylov): loose while the predictor's error
   /// dominates, no tighter than the Newton test needs at the last step. On the coarse aerofoil's
@@ -609,12 +613,6 @@ struct hb_krylov {
   /// A GMRES solve that stops at max_iterations is still used as the Newton step when its
   /// relative residual is below this (the Newton residual test decides convergence).
   double accept_tolerance = 1e-3;
-  int max_iterations = 400;
-  int restart = 50;  ///< against 100: a quarter less time for the coarse aerofoil's branch, half the basis
-  /// k of GMRES-DR(restart, k) (krylov_options::deflation); 0: plain restarts. The coarse
-  /// aerofoil's H = 5 branch to 1.05 Ubar*: 3,839 GMRES iterations with 10 against 4,023, the same
-  /// time (a solve rarely restarts: 55-90 iterations per Newton step).
-  int deflation = 0;
   /// mean_jacobian: on the coarse aerofoil (H = 5, GMRES to 1e-6) 255 / 370 GMRES iterations per
   /// point at 1.02 / 1.05 Ubar* against 566 / 1200 with mean_state, equal near onset.
   hb_preconditioner_state preconditioner = hb_preconditioner_state::mean_jacobian;
@@ -668,13 +666,13 @@ struct hb_krylov {
       internal::border_elimination<double> border;
       border.compute(state_pre, m, u, vt.transpose(), corner, internal::concat(who_, ": harmonic-balance border"));
       auto pre_full = [&](const vec<double>& r, vec<double>& z) { border.apply(state_pre, r, z); };
-      const krylov_options ko = o_.krylov(next_tolerance_.value_or(o_.relative_tolerance), who_);
+      const krylov_options ko = o_.gmres_options(next_tolerance_.value_or(o_.krylov.relative_tolerance), who_);
       next_tolerance_.reset();
       vec<double> dx = vec<double>::Zero(rhs.size());
       const krylov_report rep = gmres<double>(op, pre_full, rhs, dx, ko);
       iterations_ += rep.iterations;
-      bytes_ = hill_.bytes() + std::size_t(std::min(o_.restart, o_.max_iterations) + 1 + 6 +
-                                           (o_.deflation > 0 ? o_.deflation + 2 : 0)) *
+      bytes_ = hill_.bytes() + std::size_t(internal::krylov_basis_size(ko) + 1 + 6 +
+                                           (ko.deflation > 0 ? ko.deflation + 2 : 0)) *
                                    std::size_t(m + 3) * sizeof(double);
       if (!rep.converged && !(rep.relative_residual <= std::max(o_.accept_tolerance, ko.relative_tolerance)))
         throw convergence_error(internal::concat(ko.context, ": not converged in ", rep.iterations,
@@ -695,25 +693,21 @@ struct hb_krylov {
     std::size_t bytes_ = 0;
   };
   /// The GMRES options of a solve to relative tolerance tol.
-  krylov_options krylov(double tol, const char* who) const {
-    krylov_options ko;
+  krylov_options gmres_options(double tol, const char* who) const {
+    krylov_options ko = krylov;
     ko.relative_tolerance = tol;
-    ko.max_iterations = max_iterations;
-    ko.restart = restart;
-    ko.deflation = deflation;
-    ko.record_history = false;
     ko.context = internal::concat(who, ": GMRES on the harmonic-balance Jacobian");
     return ko;
   }
   template <dynamical_system S>
   solver<S> make(const internal::harmonic_balance_equations<S>& eq, const S& sys, const char* who) const {
-    require(fill_level >= 0 && std::isfinite(relative_tolerance) && relative_tolerance > 0 &&
-                std::isfinite(accept_tolerance) && accept_tolerance >= relative_tolerance && max_iterations >= 1 &&
-                eta_max > 0 && eta_max < 1,
-            who, ": hb_krylov options out of range (fill_level ", fill_level, ", relative_tolerance ",
-            relative_tolerance, ", accept_tolerance ", accept_tolerance, ", eta_max ", eta_max, ", max_iterations ",
-            max_iterations, ")");
-    validate_krylov_options(krylov(relative_tolerance, who), who);  // restart, deflation
+    const double tol = krylov.relative_tolerance;
+    require(fill_level >= 0 && std::isfinite(tol) && tol > 0 && std::isfinite(accept_tolerance) &&
+                accept_tolerance >= tol && krylov.max_iterations >= 1 && eta_max > 0 && eta_max < 1,
+            who, ": hb_krylov options out of range (fill_level ", fill_level, ", krylov.relative_tolerance ", tol,
+            ", accept_tolerance ", accept_tolerance, ", eta_max ", eta_max, ", krylov.max_iterations ",
+            krylov.max_iterations, ")");
+    validate_krylov_options(krylov, internal::concat(who, ": hb_krylov::krylov"));  // restart, deflation
     return solver<S>(*this, eq, sys, who);
   }
 };
@@ -850,9 +844,10 @@ struct hill_krylov_options {
   int fill_level = 1;         ///< of the per-harmonic BILU(k)
   bool single_precision_factors = false;  ///< as hb_krylov
   hb_preconditioner_state preconditioner = hb_preconditioner_state::mean_jacobian;
-  double linear_tolerance = 1e-8;  ///< relative, of each GMRES solve
-  int max_iterations = 1000, restart = 100;  ///< restart 50 stagnates at 1.05 Ubar* on the coarse aerofoil
-  int deflation = 0;  ///< k of GMRES-DR(restart, k) (krylov_options::deflation); 0: plain restarts
+  /// The GMRES of each shifted solve: relative tolerance 1e-8, at most 1,000 iterations,
+  /// GMRES(100) (GMRES(50) stagnates at 1.05 Ubar* on the coarse aerofoil); krylov.deflation = k
+  /// gives GMRES-DR(100, k).
+  krylov_options krylov{.relative_tolerance = 1e-8, .max_iterations = 1000, .restart = 100, .record_history = false};
 };
 
 /// The Floquet exponents of a cycle nearest 0 by Hill's method without forming Hill's matrix, for
@@ -874,11 +869,12 @@ floquet_result hill_floquet_krylov(const S& sys, const lco_solution& s, const hi
   const char* who = "hill_floquet_krylov";
   internal::check_guess(sys, s, vec<double>::Ones(sys.size()), who);
   require(o.exponents >= 1 && o.subspace > o.exponents + 2 && o.restarts >= 0 && std::isfinite(o.tolerance) &&
-              o.tolerance > 0 && o.fill_level >= 0 && std::isfinite(o.linear_tolerance) && o.linear_tolerance > 0 &&
-              o.max_iterations >= 1 && o.restart >= 1 && !std::isinf(o.shift),
+              o.tolerance > 0 && o.fill_level >= 0 && std::isfinite(o.krylov.relative_tolerance) &&
+              o.krylov.relative_tolerance > 0 && o.krylov.max_iterations >= 1 && !std::isinf(o.shift),
           who, ": options out of range (exponents ", o.exponents, ", subspace ", o.subspace, " > exponents + 2, restarts ",
-          o.restarts, ", tolerance ", o.tolerance, ", fill_level ", o.fill_level, ", linear_tolerance ",
-          o.linear_tolerance, ", shift ", o.shift, ")");
+          o.restarts, ", tolerance ", o.tolerance, ", fill_level ", o.fill_level, ", krylov.relative_tolerance ",
+          o.krylov.relative_tolerance, ", krylov.max_iterations ", o.krylov.max_iterations, ", shift ", o.shift, ")");
+  validate_krylov_options(o.krylov, internal::concat(who, ": krylov"));  // restart, deflation
   const Eigen::Index n = sys.size();
   const int h = s.harmonics, nn = s.instance_count();
   const Eigen::Index m = n * nn;
@@ -889,14 +885,8 @@ floquet_result hill_floquet_krylov(const S& sys, const lco_solution& s, const hi
              who);
   auto op = [&](const vec<double>& x, vec<double>& y) { hill.apply(x, y); };
   auto pre = [&](const vec<double>& r, vec<double>& z) { hill.precondition(r, z); };
-  krylov_options ko;
-  ko.relative_tolerance = o.linear_tolerance;
-  ko.max_iterations = o.max_iterations;
-  ko.restart = o.restart;
-  ko.deflation = o.deflation;
-  ko.record_history = false;
+  krylov_options ko = o.krylov;
   ko.context = internal::concat(who, ": GMRES on Hill's matrix - ", sigma, " I");
-  validate_krylov_options(ko, who);
   int solves = 0, iterations = 0;
   auto solve = [&](const vec<double>& v) {
     vec<double> x = vec<double>::Zero(m);
