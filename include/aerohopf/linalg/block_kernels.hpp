@@ -325,22 +325,34 @@ struct real_complex_row_accumulator<B> {
 #ifndef AEROHOPF_PREFETCH_DISTANCE
 #define AEROHOPF_PREFETCH_DISTANCE 8192
 #endif
+/// The requests are prefetcht2 (__builtin_prefetch locality 1), not prefetchnta (0): on Intel
+/// server cores a non-temporal prefetch fills the first-level cache only, not the second, and
+/// the sweeps ran at half the STREAM triad with it (3D b = 5 BILU(0)
+/// apply out of cache: 42-48 % with prefetchnta, 81-86 % with prefetcht2, one session on an
+/// Intel Xeon; the README's AMD EPYC figures were taken with prefetchnta).
 #ifndef AEROHOPF_PREFETCH_LOCALITY
-#define AEROHOPF_PREFETCH_LOCALITY 0
+#define AEROHOPF_PREFETCH_LOCALITY 1
 #endif
-/// The SpMV of a block_sparse_matrix on vectors of its own scalar (multiply/apply) is NOT
-/// prefetched by default: no row waits for another there, the out-of-order window and the
-/// hardware prefetchers keep the memory busy, and the extra requests (one per line, 6-7 per 5 x 5
-/// complex block) cost more than they bring. Measured with bench_linear_solver, one session,
-/// fraction of the STREAM triad, with the 8 KiB prefetch -> without: 3D b = 5 complex 64^3
-/// 64 % -> 84 %, 100^3 62 % -> 75-81 %; real 80-83 % -> 85-88 %. The real-matrix product on complex
-/// vectors (apply_shifted) keeps it: 75-77 % without, 79-92 % with.
-/// AEROHOPF_SPMV_PREFETCH_DISTANCE > 0 turns it on for experiments.
+/// The SpMV of a block_sparse_matrix on vectors of its own scalar (multiply/apply) takes the same
+/// prefetch, except on AMD Zen (-march=znverN), where no row waits for another, the out-of-order
+/// window and the hardware prefetchers keep the memory busy, and the extra requests (one per
+/// line, 6-7 per 5 x 5 complex block) cost more than they bring (3D b = 5 complex 100^3, with
+/// prefetchnta: 62 % of the STREAM triad, 75-81 % without). On Intel they pay (3D b = 5 real and
+/// complex 100^3: 72-73 % -> 81-89 %).
+/// AEROHOPF_SPMV_PREFETCH_DISTANCE sets it for experiments (0: off).
 #ifndef AEROHOPF_SPMV_PREFETCH_DISTANCE
+#if defined(__znver1__) || defined(__znver2__) || defined(__znver3__) || defined(__znver4__) || defined(__znver5__)
 #define AEROHOPF_SPMV_PREFETCH_DISTANCE 0
+#else
+#define AEROHOPF_SPMV_PREFETCH_DISTANCE AEROHOPF_PREFETCH_DISTANCE
+#endif
 #endif
 inline constexpr std::ptrdiff_t prefetch_distance_bytes = AEROHOPF_PREFETCH_DISTANCE;
 inline constexpr std::ptrdiff_t spmv_prefetch_distance_bytes = AEROHOPF_SPMV_PREFETCH_DISTANCE;
+/// ... and only for matrices whose values exceed this many bytes: from cache the SpMV has no
+/// memory latency to hide and the requests only cost issue slots (Intel, 3D b = 5 16^3: 95-98 %
+/// of an in-cache STREAM triad without them, 75-87 % with).
+inline constexpr std::size_t spmv_prefetch_min_bytes = std::size_t(24) << 20;
 inline void prefetch_ahead(const void* p, std::ptrdiff_t bytes, std::ptrdiff_t distance = prefetch_distance_bytes) {
 #if defined(__GNUC__)
   if (distance <= 0) return;

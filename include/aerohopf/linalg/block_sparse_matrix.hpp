@@ -352,8 +352,8 @@ class block_sparse_matrix {
     if constexpr (B != Eigen::Dynamic) {
       for (index i = 0; i < nbr_; ++i) {
         const storage_index p0 = row_ptr_[i], p1 = row_ptr_[i + 1];
-        // unlike the SpMV on the matrix's own scalar (block_kernels.hpp), this product gains from
-        // the prefetch (bench_linear_solver, same session: 75-77 % of STREAM without, 79-97 % with)
+        // prefetched on every machine, unlike the SpMV on the matrix's own scalar (block_kernels.hpp):
+        // it gains on AMD Zen too (bench_linear_solver, one session: 75-77 % of STREAM without, 79-97 % with)
         internal::prefetch_ahead(v + index(p0) * B * B, index(p1 - p0) * B * B * index(sizeof(double)));
         internal::real_complex_row_accumulator<B> t;
         for (storage_index p = p0; p < p1; ++p) t.add(v + index(p) * B * B, xv + index(cols[p]) * B);
@@ -409,12 +409,15 @@ class block_sparse_matrix {
     const Scalar* v = val_.data();
     const storage_index* cols = col_.data();
     if constexpr (internal::has_fast_block_kernel_v<Scalar, B>) {
+      const std::ptrdiff_t ahead = val_.size() * sizeof(Scalar) > internal::spmv_prefetch_min_bytes
+                                       ? internal::spmv_prefetch_distance_bytes
+                                       : 0;
       for (index i = 0; i < nbr_; ++i) {
         Scalar acc[B];
         for (int r = 0; r < B; ++r) acc[r] = Scalar(0.0);
         const storage_index p0 = row_ptr_[i];
         internal::prefetch_ahead(v + index(p0) * B * B, index(row_ptr_[i + 1] - p0) * B * B * index(sizeof(Scalar)),
-                                 internal::spmv_prefetch_distance_bytes);
+                                 ahead);
         internal::block_row_gemv<1, B>(v + index(p0) * B * B, cols + p0, row_ptr_[i + 1] - p0, xv, acc);
         for (int r = 0; r < B; ++r) {
           if constexpr (Accumulate) yv[i * B + r] += alpha * acc[r];
