@@ -327,9 +327,9 @@ struct real_complex_row_accumulator<B> {
 #endif
 /// The requests are prefetcht2 (__builtin_prefetch locality 1), not prefetchnta (0): on Intel
 /// server cores a non-temporal prefetch fills the first-level cache only, not the second, and
-/// the sweeps ran at half the STREAM triad with it (3D b = 5 BILU(0)
-/// apply out of cache: 42-48 % with prefetchnta, 81-86 % with prefetcht2, one session on an
-/// Intel Xeon; the README's AMD EPYC figures were taken with prefetchnta).
+/// the sweeps ran at half the STREAM triad with it (3D b = 5 BILU(0) apply out of cache: 41-48 %
+/// with prefetchnta, 81-89 % with prefetcht2, one session on an Intel Xeon; the README's AMD EPYC
+/// figures were taken with prefetchnta).
 #ifndef AEROHOPF_PREFETCH_LOCALITY
 #define AEROHOPF_PREFETCH_LOCALITY 1
 #endif
@@ -338,7 +338,7 @@ struct real_complex_row_accumulator<B> {
 /// window and the hardware prefetchers keep the memory busy, and the extra requests (one per
 /// line, 6-7 per 5 x 5 complex block) cost more than they bring (3D b = 5 complex 100^3, with
 /// prefetchnta: 62 % of the STREAM triad, 75-81 % without). On Intel they pay (3D b = 5 real and
-/// complex 100^3: 72-73 % -> 81-89 %).
+/// complex 100^3: 74-79 % -> 81-90 %).
 /// AEROHOPF_SPMV_PREFETCH_DISTANCE sets it for experiments (0: off).
 #ifndef AEROHOPF_SPMV_PREFETCH_DISTANCE
 #if defined(__znver1__) || defined(__znver2__) || defined(__znver3__) || defined(__znver4__) || defined(__znver5__)
