@@ -189,9 +189,9 @@ TEST(mpi_hopf, start_refinement_as_the_serial_one) {
   EXPECT_FALSE(distributed::solve_hopf(d, local_guess(d, start), o).start_refined);
 }
 
-// A distributed solve runs the GMRES of its serial twin: every field of the serial options'
-// krylov_options but the tolerance (the caller's forcing) carries over, the deflation included
-// (a GMRES-DR(80, 20) against a plain GMRES(300) is another solver on a hard correction).
+// A distributed solve runs the GMRES of its serial twin: the serial options' restart, deflation,
+// iteration limit and Gram-Schmidt passes carry over (the tolerance is the caller's forcing); a
+// GMRES-DR(300, 20) against a plain GMRES(300) is another solver on a hard correction.
 TEST(mpi_hopf, serial_gmres_settings_carry_over_to_the_distributed_options) {
   hopf_krylov_options ko;
   ko.krylov.restart = 300;
