@@ -738,6 +738,19 @@ int main(int argc, char** argv) {
   PetscInitialize(&pargc, &pargv, nullptr, nullptr);
 #endif
   benchmark::Initialize(&rc, rest.data());
+  // The kernels' compile-time prefetch tuning (linalg/block_kernels.hpp), so every result file
+  // says which one it measured.
+#ifdef AEROHOPF_AMD_TUNING
+  const char* vendor = "amd";
+#else
+  const char* vendor = "default";
+#endif
+  benchmark::AddCustomContext("aerohopf_prefetch",
+                              "tuning=" + std::string(vendor) + " locality=" + std::to_string(AEROHOPF_PREFETCH_LOCALITY) +
+                                  " distance=" + std::to_string(aerohopf::internal::prefetch_distance_bytes) +
+                                  " spmv_distance=" + std::to_string(aerohopf::internal::spmv_prefetch_distance_bytes<double>) +
+                                  " complex_spmv_distance=" +
+                                  std::to_string(aerohopf::internal::spmv_prefetch_distance_bytes<std::complex<double>>));
   register_all();
   benchmark::RunSpecifiedBenchmarks();
   benchmark::Shutdown();

@@ -198,12 +198,14 @@ def main():
             sys.exit("no %s: build the target bench_linear_solver first" % exe)
         run_bench(exe, args.large, args.filter, json_path, args.all_peers, args.repetitions)
     rows = rows_from_json(json_path)
+    with open(json_path) as f:
+        tuning = json.load(f).get("context", {}).get("aerohopf_prefetch", "not recorded")
     with open(args.out, "w", newline="") as f:
         w = csv.writer(f)
         w.writerow(HEADER)
         for r in rows:
             w.writerow([r[h] for h in HEADER])
-    text = summary(rows)
+    text = "Kernel prefetch tuning: %s\n" % tuning + summary(rows)
     print(text)
     with open(os.path.splitext(args.out)[0] + "_summary.txt", "w") as f:
         f.write(text + "\n")

@@ -325,30 +325,46 @@ struct real_complex_row_accumulator<B> {
 #ifndef AEROHOPF_PREFETCH_DISTANCE
 #define AEROHOPF_PREFETCH_DISTANCE 8192
 #endif
-/// The requests are prefetcht2 (__builtin_prefetch locality 1), not prefetchnta (0): on Intel
-/// server cores a non-temporal prefetch fills the first-level cache only, not the second, and
-/// the sweeps ran at half the STREAM triad with it (3D b = 5 BILU(0) apply out of cache: 41-48 %
-/// with prefetchnta, 81-89 % with prefetcht2, one session on an Intel Xeon; the README's AMD EPYC
-/// figures were taken with prefetchnta).
+/// The tuning differs by vendor, so the kernels tell AMD from the rest at compile time by the
+/// AMD-only SSE4a extension, which -march=native and -march=znverN define on every Zen (Clang 14
+/// names a Zen 5 host "k8", so the __znverN__ macros miss it; GCC 12 calls it znver3).
+#if !defined(AEROHOPF_AMD_TUNING) && defined(__SSE4A__)
+#define AEROHOPF_AMD_TUNING 1
+#endif
+/// The requests are prefetcht2 (__builtin_prefetch locality 1) except on AMD, where they are
+/// prefetchnta (0): on Intel server cores a non-temporal prefetch fills the first-level cache
+/// only, and the sweeps ran at half the STREAM triad with it (3D b = 5 BILU(0) apply out of cache:
+/// 41-48 % with prefetchnta, 81-89 % with prefetcht2, an Intel Xeon); on AMD Zen it is the better
+/// one (the same kernel 89-98 % with prefetchnta, 74-84 % with prefetcht2, a Zen 5 EPYC).
 #ifndef AEROHOPF_PREFETCH_LOCALITY
+#if defined(AEROHOPF_AMD_TUNING)
+#define AEROHOPF_PREFETCH_LOCALITY 0
+#else
 #define AEROHOPF_PREFETCH_LOCALITY 1
 #endif
+#endif
 /// The SpMV of a block_sparse_matrix on vectors of its own scalar (multiply/apply) takes the same
-/// prefetch, except on AMD Zen (-march=znverN), where no row waits for another, the out-of-order
-/// window and the hardware prefetchers keep the memory busy, and the extra requests (one per
-/// line, 6-7 per 5 x 5 complex block) cost more than they bring (3D b = 5 complex 100^3, with
-/// prefetchnta: 62 % of the STREAM triad, 75-81 % without). On Intel they pay (3D b = 5 real and
-/// complex 100^3: 74-79 % -> 81-90 %).
-/// AEROHOPF_SPMV_PREFETCH_DISTANCE sets it for experiments (0: off).
+/// prefetch, except for complex values on AMD: there no row waits for another, the out-of-order
+/// window and the hardware prefetchers keep the memory busy, and the extra requests (6-7 per 5 x 5
+/// complex block) cost more than they bring (3D b = 5 complex 64^3 and 100^3 on a Zen 5 EPYC:
+/// 60-65 % of the STREAM triad with them, 72-86 % without), while the real SpMV still gains from
+/// them. AEROHOPF_SPMV_PREFETCH_DISTANCE and AEROHOPF_SPMV_COMPLEX_PREFETCH_DISTANCE set them for
+/// experiments (0: off).
 #ifndef AEROHOPF_SPMV_PREFETCH_DISTANCE
-#if defined(__znver1__) || defined(__znver2__) || defined(__znver3__) || defined(__znver4__) || defined(__znver5__)
-#define AEROHOPF_SPMV_PREFETCH_DISTANCE 0
-#else
 #define AEROHOPF_SPMV_PREFETCH_DISTANCE AEROHOPF_PREFETCH_DISTANCE
+#endif
+#ifndef AEROHOPF_SPMV_COMPLEX_PREFETCH_DISTANCE
+#if defined(AEROHOPF_AMD_TUNING)
+#define AEROHOPF_SPMV_COMPLEX_PREFETCH_DISTANCE 0
+#else
+#define AEROHOPF_SPMV_COMPLEX_PREFETCH_DISTANCE AEROHOPF_PREFETCH_DISTANCE
 #endif
 #endif
 inline constexpr std::ptrdiff_t prefetch_distance_bytes = AEROHOPF_PREFETCH_DISTANCE;
-inline constexpr std::ptrdiff_t spmv_prefetch_distance_bytes = AEROHOPF_SPMV_PREFETCH_DISTANCE;
+/// The own-scalar SpMV's prefetch distance for values of type S.
+template <class S>
+inline constexpr std::ptrdiff_t spmv_prefetch_distance_bytes =
+    std::is_same_v<S, std::complex<double>> ? AEROHOPF_SPMV_COMPLEX_PREFETCH_DISTANCE : AEROHOPF_SPMV_PREFETCH_DISTANCE;
 /// ... and only for matrices whose values exceed this many bytes: from cache the SpMV has no
 /// memory latency to hide and the requests only cost issue slots (Intel, 3D b = 5 16^3: 95-98 %
 /// of an in-cache STREAM triad without them, 75-87 % with).

@@ -410,7 +410,7 @@ class block_sparse_matrix {
     const storage_index* cols = col_.data();
     if constexpr (internal::has_fast_block_kernel_v<Scalar, B>) {
       const std::ptrdiff_t ahead = val_.size() * sizeof(Scalar) > internal::spmv_prefetch_min_bytes
-                                       ? internal::spmv_prefetch_distance_bytes
+                                       ? internal::spmv_prefetch_distance_bytes<Scalar>
                                        : 0;
       for (index i = 0; i < nbr_; ++i) {
         Scalar acc[B];
