@@ -335,7 +335,7 @@ struct real_complex_row_accumulator<B> {
 /// prefetchnta (0): on Intel server cores a non-temporal prefetch fills the first-level cache
 /// only, and the sweeps ran at half the STREAM triad with it (3D b = 5 BILU(0) apply out of cache:
 /// 41-48 % with prefetchnta, 81-89 % with prefetcht2, an Intel Xeon); on AMD Zen it is the better
-/// one (the same kernel 89-98 % with prefetchnta, 74-84 % with prefetcht2, a Zen 5 EPYC).
+/// one (the same kernel 89-96 % with prefetchnta, 70-87 % with prefetcht2, a Zen 5 EPYC).
 #ifndef AEROHOPF_PREFETCH_LOCALITY
 #if defined(AEROHOPF_AMD_TUNING)
 #define AEROHOPF_PREFETCH_LOCALITY 0
@@ -347,7 +347,7 @@ struct real_complex_row_accumulator<B> {
 /// prefetch, except for complex values on AMD: there no row waits for another, the out-of-order
 /// window and the hardware prefetchers keep the memory busy, and the extra requests (6-7 per 5 x 5
 /// complex block) cost more than they bring (3D b = 5 complex 64^3 and 100^3 on a Zen 5 EPYC:
-/// 60-65 % of the STREAM triad with them, 72-86 % without), while the real SpMV still gains from
+/// 58-65 % of the STREAM triad with them, 77-85 % without), while the real SpMV still gains from
 /// them. AEROHOPF_SPMV_PREFETCH_DISTANCE and AEROHOPF_SPMV_COMPLEX_PREFETCH_DISTANCE set them for
 /// experiments (0: off).
 #ifndef AEROHOPF_SPMV_PREFETCH_DISTANCE
@@ -360,6 +360,11 @@ struct real_complex_row_accumulator<B> {
 #define AEROHOPF_SPMV_COMPLEX_PREFETCH_DISTANCE AEROHOPF_PREFETCH_DISTANCE
 #endif
 #endif
+static_assert(AEROHOPF_PREFETCH_LOCALITY >= 0 && AEROHOPF_PREFETCH_LOCALITY <= 3,
+              "AEROHOPF_PREFETCH_LOCALITY must be 0 (prefetchnta), 1 (t2), 2 (t1) or 3 (t0)");
+static_assert(AEROHOPF_PREFETCH_DISTANCE >= 0 && AEROHOPF_SPMV_PREFETCH_DISTANCE >= 0 &&
+                  AEROHOPF_SPMV_COMPLEX_PREFETCH_DISTANCE >= 0,
+              "the AEROHOPF_*PREFETCH_DISTANCE macros are byte distances >= 0 (0: no prefetch)");
 inline constexpr std::ptrdiff_t prefetch_distance_bytes = AEROHOPF_PREFETCH_DISTANCE;
 /// The own-scalar SpMV's prefetch distance for values of type S.
 template <class S>
