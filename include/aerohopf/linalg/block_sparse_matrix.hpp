@@ -352,8 +352,8 @@ class block_sparse_matrix {
     if constexpr (B != Eigen::Dynamic) {
       for (index i = 0; i < nbr_; ++i) {
         const storage_index p0 = row_ptr_[i], p1 = row_ptr_[i + 1];
-        // prefetched on every machine, unlike the SpMV on the matrix's own scalar (block_kernels.hpp):
-        // it gains on AMD Zen too (bench_linear_solver, one session: 75-77 % of STREAM without, 79-97 % with)
+        // prefetched on every machine, unlike the complex SpMV on AMD (block_kernels.hpp): it gains
+        // there too (Zen 5, bench_linear_solver: 58-60 % of STREAM without, 93-101 % with prefetchnta)
         internal::prefetch_ahead(v + index(p0) * B * B, index(p1 - p0) * B * B * index(sizeof(double)));
         internal::real_complex_row_accumulator<B> t;
         for (storage_index p = p0; p < p1; ++p) t.add(v + index(p) * B * B, xv + index(cols[p]) * B);
